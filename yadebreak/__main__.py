@@ -1,0 +1,120 @@
+"""Command line: `python -m yadebreak demo | families | materials` (no YADE needed)."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from . import families, model
+from .materials import MaterialError, available_materials, load_material
+
+
+def _plt():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def demo(args):
+    """Breakage probability and t10 curves of a material: Eqs. 1-4 and 8-10, plotted to PNG."""
+    mat = load_material(args.material)
+    steel = load_material("steel")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    plt = _plt()
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    energies = np.geomspace(1.0, 1e4, 300)
+    for size_mm in (2.0, 5.5, 12.0, 37.5):
+        p = mat.breakage_probability(energies, size_mm * 1e-3, partner=steel)
+        axes[0].semilogx(energies, 100 * p, label=f"{size_mm:g} mm")
+    axes[0].set(xlabel="specific impact energy Ek/mp on steel (J/kg)",
+                ylabel="breakage probability (%)", title=f"{mat.name}: Eqs. 1-4")
+    axes[0].legend()
+    ratio = np.linspace(1.0, 60.0, 300)
+    axes[1].plot(ratio, mat.t10(ratio))
+    axes[1].axhline(mat.A, ls=":", c="k", label=f"A = {mat.A:g} %")
+    axes[1].set(xlabel="Ek' / (mp E)", ylabel="t10' (%)", title="Eq. 8")
+    axes[1].legend()
+    x = np.geomspace(1e-3, 1.0, 300)
+    for t in (mat.t10_min, 10.0, 20.0, 40.0):
+        axes[2].semilogx(x, model.progeny_passing(t, mat.beta_params, x), label=f"t10 = {t:.3g} %")
+    axes[2].set(xlabel="relative size x = d / d_parent", ylabel="cumulative passing (%)",
+                title="Eq. 10 with Eqs. 11-12 below 1/75")
+    axes[2].legend()
+    fig.tight_layout()
+    path = out / f"model_{mat.name}.png"
+    fig.savefig(path, dpi=110)
+    e50 = float(mat.median_fracture_energy(5.5e-3))
+    summary = {"material": mat.name, "E50_5.5mm_J_per_kg": e50,
+               "energy_partition_on_steel": mat.energy_partition(steel),
+               "t10_min_percent": mat.t10_min, "plot": str(path)}
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    print(f"{mat.name}: E50(5.5 mm) = {e50:.1f} J/kg, e on steel = "
+          f"{mat.energy_partition(steel):.3f}, t10' from {mat.t10_min:.2f} % to A = {mat.A:g} %")
+    print(f"wrote {path}")
+
+
+def plot_families(args):
+    """Each family's cumulative distribution and the Eq. 10 target (the paper's Fig. 2)."""
+    beta = model.TABLE1_BETA_PARAMS if args.material == "table1" else \
+        load_material(args.material).beta_params
+    fs = families.family_set(args.t10, beta, seed=args.seed)
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7, 5))
+    x = families.CLASS_SIZES
+    for i, (frac, p) in enumerate(zip(fs.class_fractions, fs.probabilities)):
+        ax.semilogx(x, families.boundary_passing(frac), "o-", ms=3, lw=0.8, alpha=0.7,
+                    label=f"family {i + 1} ({100 * p:.0f} %)")
+    ax.semilogx(x, families.boundary_passing(fs.mixture_fractions), "k--", lw=2,
+                label="mixture (probability-weighted)")
+    xs = np.geomspace(x[-1], 1.0, 200)
+    ax.semilogx(xs, model.progeny_passing(args.t10, beta, xs), "r-", lw=2, label="Eq. 10")
+    ax.set(xlabel="relative size x", ylabel="cumulative passing (%)",
+           title=f"families for t10' = {args.t10:g} % ({args.material})")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(args.out, dpi=110)
+    print(f"{len(fs.probabilities)} families, volumes {fs.volumes.min():.4f}-{fs.volumes.max():.4f} "
+          f"of the parent; t_n of the mixture "
+          f"{np.round(fs.mixture_markers(), 2).tolist()} vs Eq. 10 "
+          f"{np.round(model.t_markers(args.t10, beta)[:4], 2).tolist()}")
+    print(f"wrote {args.out}")
+
+
+def list_materials(_args):
+    for name in available_materials():
+        mat = load_material(name)
+        print(f"{name:12s} {'breakable' if mat.breakable else 'non-breakable':14s} {mat.description}")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m yadebreak")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("demo", help="plot breakage probability and t10 curves of a material")
+    p.add_argument("--material", default="copper_ore")
+    p.add_argument("--out", default="out/demo")
+    p.set_defaults(func=demo)
+    p = sub.add_parser("families", help="plot the family set of a t10' (paper Fig. 2)")
+    p.add_argument("--material", default="table1", help="a material name, or table1")
+    p.add_argument("--t10", type=float, default=3.0)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", default="out/families.png")
+    p.set_defaults(func=plot_families)
+    p = sub.add_parser("materials", help="list the material library")
+    p.set_defaults(func=list_materials)
+    args = parser.parse_args(argv)
+    try:
+        args.func(args)
+    except MaterialError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,346 @@
+"""Material library: TOML files in materials/, read with tomllib, validated and converted to SI once.
+
+A file states its units as the paper prints them (mm, GPa, %); the Material object holds SI values
+(m, Pa) except t10-related percentages (A), which stay in percent like t10 itself.
+Never imports yade.
+"""
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Mapping
+
+import numpy as np
+
+from . import model
+
+MATERIALS_DIR = Path(__file__).resolve().parent.parent / "materials"
+
+_N_KEYS = {"1.2": 1.2, "1.5": 1.5, "2": 2.0, "4": 4.0, "25": 25.0, "50": 50.0, "75": 75.0}
+
+
+class MaterialError(ValueError):
+    """A material file that cannot be used. `problems` lists every problem found, one per line."""
+
+    def __init__(self, source, problems):
+        self.source = str(source)
+        self.problems = list(problems)
+        lines = "\n".join(f"  - {p}" for p in self.problems)
+        super().__init__(f"material file {self.source} has {len(self.problems)} problem(s):\n{lines}")
+
+
+@dataclass(frozen=True)
+class ContactParams:
+    """Contact parameters of a material pair (paper Table 6)."""
+
+    friction: float
+    rolling_friction: float
+    restitution: float
+
+
+@dataclass(frozen=True)
+class Material:
+    """An immutable material. SI units: density kg/m3, young_modulus Pa, d0 m, energies J/kg."""
+
+    name: str
+    source: str
+    description: str
+    breakable: bool
+    density: float
+    young_modulus: float
+    poisson_ratio: float
+    contacts: Mapping[str, ContactParams]
+    contact_like: str | None = None
+    breakage_model: str | None = None
+    # Tavares breakage parameters (None for non-breakable materials)
+    e_inf: float | None = None
+    d0: float | None = None
+    phi: float | None = None
+    sigma: float | None = None
+    emax_ratio: float | None = None
+    gamma: float | None = None
+    A: float | None = None
+    b_prime: float | None = None
+    kappa: float | None = None
+    device_stiffness: float = model.DEVICE_STIFFNESS_STEEL
+    beta_params: Mapping[float, tuple] | None = None
+    beta_source: str | None = None
+    extra: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
+
+    # -- stiffness ---------------------------------------------------------------------------
+    @property
+    def hertz_stiffness(self):
+        """k = Y / (1 - nu^2) in Pa."""
+        return float(model.hertz_stiffness(self.young_modulus, self.poisson_ratio))
+
+    def energy_partition(self, other):
+        """Eq. 4: share of a contact's energy this material absorbs against `other` (a Material)."""
+        return float(model.energy_partition(self.hertz_stiffness, other.hertz_stiffness))
+
+    # -- breakage ----------------------------------------------------------------------------
+    def _need_breakable(self, what):
+        if not self.breakable:
+            raise ValueError(f"material '{self.name}' is not breakable: it has no {what}")
+
+    def median_fracture_energy(self, size):
+        """Eq. 3: E50 (J/kg) at particle size `size` (m), against this material's device stiffness."""
+        self._need_breakable("fracture energy")
+        return model.median_fracture_energy(size, self.e_inf, self.d0, self.phi,
+                                            self.hertz_stiffness, self.device_stiffness)
+
+    def fracture_energy_cdf(self, energy, size):
+        """Eqs. 1-3: probability that a particle of size `size` (m) has fracture energy below `energy`."""
+        return model.fracture_energy_cdf(energy, self.median_fracture_energy(size), self.sigma,
+                                         self.emax_ratio)
+
+    def fracture_energy_ppf(self, u, size):
+        """Eqs. 1-3 inverted: the fracture energy (J/kg) at probability u for size `size` (m)."""
+        return model.fracture_energy_ppf(u, self.median_fracture_energy(size), self.sigma,
+                                         self.emax_ratio)
+
+    def sample_fracture_energy(self, rng, size):
+        """Eqs. 1-3: one fracture energy (J/kg) per size in `size` (m), from Generator `rng`."""
+        size = np.asarray(size, dtype=float)
+        return model.sample_fracture_energy(rng, self.median_fracture_energy(size), self.sigma,
+                                            self.emax_ratio, size=size.shape)
+
+    def breakage_probability(self, specific_energy, size, partner=None):
+        """Probability that a fresh particle of size `size` (m) breaks when a contact brings it
+        `specific_energy` = Ek/mp (J/kg), of which it absorbs e (Eq. 4) against `partner`
+        (a Material; None means the energy given is already Ek'/mp)."""
+        share = 1.0 if partner is None else self.energy_partition(partner)
+        return self.fracture_energy_cdf(share * np.asarray(specific_energy, dtype=float), size)
+
+    def t10(self, ratio):
+        """Eq. 8 with this material's A, b' and kappa; ratio = Ek' / (mp E)."""
+        self._need_breakable("t10")
+        return model.t10(ratio, self.A, self.b_prime, self.kappa)
+
+    @property
+    def t10_min(self):
+        """Eq. 9: t10' (%) of primary breakage."""
+        self._need_breakable("t10")
+        return float(model.t10_primary(self.A, self.b_prime, self.kappa))
+
+    def contact_with(self, other):
+        """Contact parameters (Table 6) for the pair (self, other).
+
+        Looked up, in order: either file's [contact.<other name>] table; the [contact.self] table
+        when both are the same material; then, for a material that declares `contact_like = "X"`
+        (rubber borrows steel's, as the paper did in Fig. 9), the partner's [contact.X] table.
+        """
+        candidates = [(self, other.name), (other, self.name)]
+        if self.name == other.name:
+            candidates.append((self, "self"))
+        candidates += [(self, other.contact_like), (other, self.contact_like)]
+        for mat, key in candidates:
+            if key is not None and key in mat.contacts:
+                return mat.contacts[key]
+        raise KeyError(f"no contact parameters for the pair '{self.name}' / '{other.name}': add a "
+                       f"[contact.{other.name}] table to {self.source} or a [contact.{self.name}] "
+                       f"table to {other.source}")
+
+
+# ------------------------------------------------------------------------------- validation
+# (key, required, lower, lower inclusive, upper, upper inclusive, unit in file, SI factor)
+_ELASTIC = [
+    ("density", 100.0, True, 25000.0, True, "kg/m3", 1.0),
+    ("young_modulus", 0.0, False, 1500.0, True, "GPa", 1e9),
+    ("poisson_ratio", 0.0, True, 0.5, False, "-", 1.0),
+]
+_TAVARES = [
+    ("e_inf", 0.0, False, math.inf, False, "J/kg", 1.0),
+    ("d0", 0.0, False, math.inf, False, "mm", 1e-3),
+    ("phi", 0.0, True, 10.0, True, "-", 1.0),
+    ("sigma", 0.0, False, 10.0, True, "-", 1.0),
+    ("emax_ratio", 1.0, False, math.inf, False, "-", 1.0),
+    ("gamma", 0.0, False, 1000.0, True, "-", 1.0),
+    ("A", 0.0, False, 100.0, True, "%", 1.0),
+    ("b_prime", 0.0, False, math.inf, False, "-", 1.0),
+    ("kappa", 0.0, False, math.inf, False, "-", 1.0),
+]
+_TAVARES_DEFAULTS = {"emax_ratio": 100.0, "kappa": 1.0}
+_CONTACT = [
+    ("friction", 0.0, True, 10.0, True, "-", 1.0),
+    ("rolling_friction", 0.0, True, 10.0, True, "-", 1.0),
+    ("restitution", 0.0, False, 1.0, True, "-", 1.0),
+]
+_TOP_KEYS = {"name", "description", "breakable", "contact_like", "elastic", "breakage", "contact"}
+
+
+def _range_text(lo, lo_inc, hi, hi_inc):
+    left = "[" if lo_inc else "("
+    right = "]" if hi_inc else ")"
+    hi_txt = "inf" if math.isinf(hi) else f"{hi:g}"
+    return f"{left}{lo:g}, {hi_txt}{right}"
+
+
+def _number(table, key, where, problems, lo, lo_inc, hi, hi_inc, unit, required=True,
+            default=None):
+    """Read one number, checking type and range; append any problem and return None on failure."""
+    if key not in table:
+        if required and default is None:
+            problems.append(f"{where}.{key}: missing (a number in {unit}, accepted range "
+                            f"{_range_text(lo, lo_inc, hi, hi_inc)})")
+            return None
+        return default
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        problems.append(f"{where}.{key}: must be a number in {unit}, got {type(value).__name__} "
+                        f"{value!r}")
+        return None
+    value = float(value)
+    ok_lo = value >= lo if lo_inc else value > lo
+    ok_hi = value <= hi if hi_inc else value < hi
+    if not (math.isfinite(value) and ok_lo and ok_hi):
+        problems.append(f"{where}.{key} = {value:g} {unit} is out of range: accepted "
+                        f"{_range_text(lo, lo_inc, hi, hi_inc)}")
+        return None
+    return value
+
+
+def _check_keys(table, allowed, where, problems):
+    for key in table:
+        if key not in allowed:
+            problems.append(f"{where}.{key}: unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def _read_table(doc, key, where, problems, required=True):
+    value = doc.get(key)
+    if value is None:
+        if required:
+            problems.append(f"{where}{key}: missing table [{where}{key}]")
+        return {}
+    if not isinstance(value, dict):
+        problems.append(f"{where}{key}: must be a table, got {type(value).__name__}")
+        return {}
+    return value
+
+
+def _parse(doc, source):
+    problems = []
+    _check_keys(doc, _TOP_KEYS, "(top level)", problems)
+    name = doc.get("name", Path(source).stem)
+    if not isinstance(name, str) or not name:
+        problems.append(f"name: must be a non-empty string, got {name!r}")
+        name = Path(source).stem
+    description = doc.get("description", "")
+    if not isinstance(description, str):
+        problems.append("description: must be a string")
+    breakable = doc.get("breakable")
+    if not isinstance(breakable, bool):
+        problems.append(f"breakable: missing or not true/false (got {breakable!r})")
+        breakable = False
+    contact_like = doc.get("contact_like")
+    if contact_like is not None and not isinstance(contact_like, str):
+        problems.append("contact_like: must be the name of another material")
+        contact_like = None
+
+    elastic = _read_table(doc, "elastic", "", problems)
+    _check_keys(elastic, {k[0] for k in _ELASTIC}, "elastic", problems)
+    values = {}
+    for key, lo, lo_inc, hi, hi_inc, unit, factor in _ELASTIC:
+        v = _number(elastic, key, "elastic", problems, lo, lo_inc, hi, hi_inc, unit)
+        values[key] = None if v is None else v * factor
+
+    contacts = {}
+    contact_doc = _read_table(doc, "contact", "", problems, required=contact_like is None)
+    for other, table in contact_doc.items():
+        where = f"contact.{other}"
+        if not isinstance(table, dict):
+            problems.append(f"{where}: must be a table")
+            continue
+        _check_keys(table, {k[0] for k in _CONTACT}, where, problems)
+        got = [_number(table, k, where, problems, lo, li, hi, hi_i, u)
+               for k, lo, li, hi, hi_i, u, _ in _CONTACT]
+        if None not in got:
+            contacts[other] = ContactParams(*got)
+
+    breakage = _read_table(doc, "breakage", "", problems, required=breakable)
+    model_name = None
+    beta_params = None
+    beta_source = None
+    if breakable:
+        model_name = breakage.get("model", "tavares")
+        if model_name != "tavares":
+            problems.append(f"breakage.model = {model_name!r}: accepted 'tavares'")
+        allowed = {k[0] for k in _TAVARES} | {"model", "device_stiffness", "beta", "beta_source"}
+        _check_keys(breakage, allowed, "breakage", problems)
+        for key, lo, lo_inc, hi, hi_inc, unit, factor in _TAVARES:
+            v = _number(breakage, key, "breakage", problems, lo, lo_inc, hi, hi_inc, unit,
+                        default=_TAVARES_DEFAULTS.get(key))
+            values[key] = None if v is None else v * factor
+        dev = _number(breakage, "device_stiffness", "breakage", problems, 0.0, False, 1500.0,
+                      True, "GPa", required=False, default=model.DEVICE_STIFFNESS_STEEL / 1e9)
+        values["device_stiffness"] = None if dev is None else dev * 1e9
+        beta_source = breakage.get("beta_source", "material")
+        if beta_source not in ("material", "table1"):
+            problems.append(f"breakage.beta_source = {beta_source!r}: accepted 'material' (the "
+                            "[breakage.beta] table) or 'table1' (the paper's Table 1 average)")
+        if beta_source == "table1":
+            if "beta" in breakage:
+                problems.append("breakage.beta: given although beta_source = 'table1'; remove one")
+            beta_params = model.TABLE1_BETA_PARAMS
+        else:
+            beta_table = _read_table(breakage, "beta", "breakage.", problems)
+            _check_keys(beta_table, set(_N_KEYS), "breakage.beta", problems)
+            parsed = {}
+            for key, n in _N_KEYS.items():
+                pair = beta_table.get(key)
+                where = f'breakage.beta."{key}"'
+                if pair is None:
+                    if beta_table:
+                        problems.append(f"{where}: missing ([alpha, beta] for n = {key})")
+                    continue
+                if (not isinstance(pair, list) or len(pair) != 2
+                        or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in pair)):
+                    problems.append(f"{where}: must be a pair of numbers [alpha, beta], got {pair!r}")
+                    continue
+                if not all(math.isfinite(v) and v > 0 for v in pair):
+                    problems.append(f"{where} = {pair}: alpha and beta must be > 0, accepted range "
+                                    "(0, inf)")
+                    continue
+                parsed[n] = (float(pair[0]), float(pair[1]))
+            beta_params = MappingProxyType(parsed) if len(parsed) == 7 else None
+    elif "breakage" in doc:
+        problems.append("breakage: given for a material with breakable = false")
+
+    if problems:
+        raise MaterialError(source, problems)
+    return Material(name=name, source=str(source), description=description, breakable=breakable,
+                    contacts=MappingProxyType(contacts), contact_like=contact_like,
+                    breakage_model=model_name, beta_params=beta_params, beta_source=beta_source, **values)
+
+
+def available_materials(directory=MATERIALS_DIR):
+    """Names of the material files shipped in `directory`."""
+    return sorted(p.stem for p in Path(directory).glob("*.toml"))
+
+
+def load_material(name_or_path):
+    """Load and validate a material: a name from materials/ ('copper_ore') or a path to a .toml file.
+
+    Every problem is reported at once in a MaterialError naming the file, the field and the
+    accepted range. Unknown names list the available materials.
+    """
+    text = str(name_or_path)
+    path = Path(text)
+    if not (text.endswith(".toml") or path.exists()):
+        path = MATERIALS_DIR / f"{text}.toml"
+        if not path.exists():
+            raise MaterialError(text, [f"unknown material '{text}': available are "
+                                       f"{', '.join(available_materials())} (or give a path to a "
+                                       ".toml file)"])
+    if not path.is_file():
+        raise MaterialError(path, ["file not found"])
+    raw = path.read_bytes()
+    if not raw.strip():
+        raise MaterialError(path, ["the file is empty: see materials/copper_ore.toml for the format"])
+    try:
+        doc = tomllib.loads(raw.decode("utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise MaterialError(path, [f"not valid TOML: {exc}"]) from None
+    return _parse(doc, path)

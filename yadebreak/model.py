@@ -1,0 +1,317 @@
+"""The Tavares UFRJ breakage model as plain, vectorised functions.
+
+Equation numbers are those of ../shared/MODEL.md (and of Tavares et al., the EDEM
+sphere-replacement paper). SI units throughout: sizes in metres, stiffnesses and moduli in
+pascals, specific energies in J/kg, masses in kg. t10 and the t_n markers are percentages, as the
+paper prints them.
+
+This module imports only numpy, scipy and the standard library: it never imports yade.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from types import MappingProxyType
+
+import numpy as np
+from scipy import special
+
+#: The seven screen ratios n of Eq. 10 (passing 1/n of the parent size).
+N_VALUES = (1.2, 1.5, 2.0, 4.0, 25.0, 50.0, 75.0)
+
+#: Paper Table 1: incomplete-beta parameters (alpha, beta) averaged over 40 materials.
+TABLE1_BETA_PARAMS = MappingProxyType({
+    1.2: (0.448, 10.508),
+    1.5: (0.706, 7.913),
+    2.0: (0.959, 5.780),
+    4.0: (1.105, 2.619),
+    25.0: (0.981, 0.524),
+    50.0: (0.956, 0.339),
+    75.0: (0.934, 0.255),
+})
+
+#: Hertzian stiffness of the steel calibration device (Eq. 3), Pa.
+DEVICE_STIFFNESS_STEEL = 230e9
+
+#: Finest resolved relative size of a replacement event, 2**(-9/4) = 0.210 (Table 2).
+X_MIN = 2.0 ** (-9.0 / 4.0)
+
+
+# --------------------------------------------------------------------------- stiffness, Eq. 4
+def hertz_stiffness(young, poisson):
+    """Hertzian stiffness k = Y / (1 - nu^2) in Pa (MODEL.md Sections 1-2), Y in Pa."""
+    young = np.asarray(young, dtype=float)
+    poisson = np.asarray(poisson, dtype=float)
+    return young / (1.0 - poisson ** 2)
+
+
+def energy_partition(k_particle, k_other):
+    """Eq. 4: share e = 1 / (1 + kp/km) of a contact's energy absorbed by the particle.
+
+    Both stiffnesses in the same unit (Pa). Same material gives 0.5; copper ore on steel 0.806.
+    """
+    k_particle = np.asarray(k_particle, dtype=float)
+    k_other = np.asarray(k_other, dtype=float)
+    return 1.0 / (1.0 + k_particle / k_other)
+
+
+# --------------------------------------------------------------------------- Eqs. 1-3
+def median_fracture_energy(size, e_inf, d0, phi, k_particle, k_device=DEVICE_STIFFNESS_STEEL):
+    """Eq. 3: median specific fracture energy E50(d) in J/kg.
+
+    E50 = Einf [1 + (d0/d)^phi] / (1 + kp/ks); size and d0 in metres, stiffnesses in Pa.
+    """
+    size = np.asarray(size, dtype=float)
+    return e_inf * (1.0 + (d0 / size) ** phi) / (1.0 + k_particle / k_device)
+
+
+def fracture_energy_cdf(energy, e50, sigma, emax_ratio):
+    """Eqs. 1-2: P(E), the upper-truncated lognormal cdf of specific fracture energy.
+
+    energy and e50 in J/kg; sigma is the standard deviation of ln E*; emax_ratio = Emax/E50 > 1.
+    Zero at E <= 0, one at E >= Emax.
+    """
+    energy, e50, sigma, emax_ratio = np.broadcast_arrays(
+        *(np.asarray(a, dtype=float) for a in (energy, e50, sigma, emax_ratio)))
+    emax = e50 * emax_ratio
+    inside = (energy > 0.0) & (energy < emax)
+    e_in = np.where(inside, energy, 0.5 * emax)
+    # ln E* = ln E - ln(1 - E/Emax); log1p keeps precision near the truncation.
+    log_e_star = np.log(e_in) - np.log1p(-e_in / emax)
+    p = special.ndtr((log_e_star - np.log(e50)) / sigma)
+    p = np.where(inside, p, np.where(energy >= emax, 1.0, 0.0))
+    return p[()] if p.ndim == 0 else p
+
+
+def fracture_energy_ppf(u, e50, sigma, emax_ratio):
+    """Inverse of Eqs. 1-2: the specific fracture energy (J/kg) at cumulative probability u.
+
+    E* = E50 exp(sigma * Phi^-1(u)) (Phi^-1(u) = sqrt(2) erfinv(2u - 1)), E = E* Emax / (Emax + E*).
+    u = 0 gives 0 and u = 1 gives Emax.
+    """
+    u, e50, sigma, emax_ratio = np.broadcast_arrays(
+        *(np.asarray(a, dtype=float) for a in (u, e50, sigma, emax_ratio)))
+    emax = e50 * emax_ratio
+    with np.errstate(over="ignore", divide="ignore"):
+        # Emax/E* = (Emax/E50) exp(-sigma z); written this way E -> Emax as z -> +inf without inf/inf.
+        ratio = emax_ratio * np.exp(-sigma * special.ndtri(u))
+        e = emax / (1.0 + ratio)
+    return e[()] if e.ndim == 0 else e
+
+
+def sample_fracture_energy(rng, e50, sigma, emax_ratio, size=None):
+    """Draw specific fracture energies (J/kg) from Eqs. 1-2 with a numpy Generator.
+
+    Inversion sampling: u ~ U(0, 1] (1 - rng.random(), so that u = 0 never gives E = 0).
+    """
+    shape = size if size is not None else np.broadcast(
+        np.asarray(e50), np.asarray(sigma), np.asarray(emax_ratio)).shape
+    u = 1.0 - rng.random(shape)
+    return fracture_energy_ppf(u, e50, sigma, emax_ratio)
+
+
+def breakage_probability(specific_energy, e50, sigma, emax_ratio):
+    """Probability that a fresh particle breaks under specific energy e Ek/mp (J/kg): P(E < e Ek/mp).
+
+    The same function as Eqs. 1-2, named for what scripts plot against simulations.
+    """
+    return fracture_energy_cdf(specific_energy, e50, sigma, emax_ratio)
+
+
+# --------------------------------------------------------------------------- Eqs. 5-6
+def _damage_residual(log_d, log_r, gamma):
+    """ln r(D) - ln r for D = exp(log_d): Eq. 6 solved for the ratio, increasing in D on (0, 1)."""
+    d = np.exp(log_d)
+    p = 5.0 / (2.0 * gamma)
+    return p * log_d + np.log(2.0 * gamma + 5.0 - 5.0 * d) - np.log(2.0 * gamma) - log_r
+
+
+def damage(ratio, gamma):
+    """Eq. 6: the damage D in [0, 1) for ratio r = Ek'_max / (mp E) in [0, 1) and gamma > 0.
+
+    D = [2 gamma / (2 gamma - 5 D + 5) * r]^(2 gamma / 5) is implicit. Solved for D as the inverse of
+    the explicit, strictly increasing r(D) = D^(5/(2 gamma)) (2 gamma + 5 - 5 D) / (2 gamma): the
+    root is unique on (0, 1) and lies in [g(0), g(1)] with g the right-hand side, a bracket no wider
+    than one unit in ln D. Safeguarded Newton on ln D, vectorised; exact to round-off.
+    r <= 0 gives 0. r >= 1 is a breakage, not damage: it returns 1.
+    """
+    ratio, gamma = np.broadcast_arrays(np.asarray(ratio, dtype=float), np.asarray(gamma, dtype=float))
+    out = np.zeros(ratio.shape)
+    active = (ratio > 0.0) & (ratio < 1.0)
+    out[ratio >= 1.0] = 1.0
+    if np.any(active):
+        r = ratio[active]
+        g = gamma[active]
+        log_r = np.log(r)
+        q = 2.0 * g / 5.0
+        lo = q * (log_r + np.log(2.0 * g / (2.0 * g + 5.0)))   # ln g(0)
+        hi = q * log_r                                         # ln g(1)
+        y = 0.5 * (lo + hi)
+        for _ in range(100):
+            f = _damage_residual(y, log_r, g)
+            lo = np.where(f < 0.0, y, lo)
+            hi = np.where(f >= 0.0, y, hi)
+            d = np.exp(y)
+            slope = 5.0 / (2.0 * g) - 5.0 * d / (2.0 * g + 5.0 - 5.0 * d)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                y_new = y - f / slope
+            outside = ~np.isfinite(y_new) | (y_new <= lo) | (y_new >= hi)
+            y_new = np.where(outside, 0.5 * (lo + hi), y_new)
+            done = np.abs(y_new - y) <= 1e-15 * np.maximum(1.0, np.abs(y))
+            y = y_new
+            if np.all(done):
+                break
+        out[active] = np.minimum(np.exp(y), np.nextafter(1.0, 0.0))
+    return out[()] if out.ndim == 0 else out
+
+
+def weakened_fracture_energy(energy, ratio, gamma):
+    """Eq. 5: E' = E (1 - D), D from Eq. 6 at ratio r = Ek'_max / (mp E); energies in J/kg."""
+    return np.asarray(energy, dtype=float) * (1.0 - damage(ratio, gamma))
+
+
+# --------------------------------------------------------------------------- Eqs. 7-9
+def t10(ratio, A, b_prime, kappa=1.0):
+    """Eq. 8: t10' (%) of one particle broken at ratio = Ek' / (mp E) (E its own fracture energy).
+
+    t10' = A [1 - exp(-b' ratio / kappa)]. With ratio = (Ek/mp) / E50b this is Eq. 7, and with
+    ratio = 1, Eq. 9 (primary breakage). Bounded by A, increasing in ratio.
+    """
+    ratio = np.asarray(ratio, dtype=float)
+    return A * -np.expm1(-b_prime * ratio / kappa)
+
+
+def t10_primary(A, b_prime, kappa=1.0):
+    """Eq. 9: the smallest t10' (%) of a breakage, at Ek'/(mp E) = 1."""
+    return t10(1.0, A, b_prime, kappa)
+
+
+# --------------------------------------------------------------------------- Eq. 10
+def t_n(t10_percent, alpha, beta):
+    """Eq. 10: t_n = 100 I_x(alpha_n, beta_n) (%), x = t10 / 100."""
+    x = np.clip(np.asarray(t10_percent, dtype=float) / 100.0, 0.0, 1.0)
+    return 100.0 * special.betainc(alpha, beta, x)
+
+
+def t_markers(t10_percent, beta_params):
+    """All seven t_n of Eq. 10, as an array of shape t10.shape + (7,), ordered as N_VALUES."""
+    t10_percent = np.asarray(t10_percent, dtype=float)
+    return np.stack([t_n(t10_percent, *beta_params[n]) for n in N_VALUES], axis=-1)
+
+
+def _passing_anchors(t10_percent, beta_params):
+    """Anchor points (ln x ascending, passing % with shape t10.shape + (9,)) of the progeny curve.
+
+    x = 1/75 ... 1/25, 1/10 (t10), 1/4 ... 1/1.2, 1 (100 %). Made non-decreasing in x, because a
+    fitted marker may cross its neighbour at extreme t10.
+    """
+    t10_percent = np.asarray(t10_percent, dtype=float)
+    markers = t_markers(t10_percent, beta_params)            # ordered 1.2 ... 75 (coarse to fine)
+    fine_to_coarse = np.concatenate([
+        markers[..., :3:-1],                                  # 75, 50, 25
+        t10_percent[..., None],                               # 10
+        markers[..., 3::-1],                                  # 4, 2, 1.5, 1.2
+        np.full(t10_percent.shape + (1,), 100.0)], axis=-1)
+    fine_to_coarse = np.minimum(np.maximum.accumulate(fine_to_coarse, axis=-1), 100.0)
+    n_fine_to_coarse = np.array([75.0, 50.0, 25.0, 10.0, 4.0, 2.0, 1.5, 1.2, 1.0])
+    return -np.log(n_fine_to_coarse), fine_to_coarse
+
+
+def fines_exponent(t10_percent, beta_params):
+    """Eq. 12: Gaudin-Schuhmann exponent lambda = ln(t4 / t75) / ln(75 / 4) at this t10'."""
+    t10_percent = np.asarray(t10_percent, dtype=float)
+    t4 = t_n(t10_percent, *beta_params[4.0])
+    t75 = t_n(t10_percent, *beta_params[75.0])
+    return np.log(t4 / t75) / np.log(75.0 / 4.0)
+
+
+def fines_passing(x, x_top, exponent):
+    """Eq. 11: fraction B(x) = (x / x_top)^lambda (0-1) of a fines mass finer than x, capped at 1."""
+    x = np.asarray(x, dtype=float)
+    ratio = np.clip(x / x_top, 0.0, 1.0)
+    return ratio ** exponent
+
+
+def progeny_passing(t10_percent, beta_params, x):
+    """Cumulative percent of progeny mass passing relative size x (0 < x, fraction of parent size).
+
+    From the seven t_n of Eq. 10, t10 at x = 0.1 and 100 % at x = 1, interpolated linearly in
+    passing against ln x; below x = 1/75 the Gaudin-Schuhmann tail of Eq. 11 with the exponent of
+    Eq. 12 continues the curve. Broadcasts t10 (shape S) against x (shape X) to S + X when both are
+    arrays of more than one element; scalars broadcast as usual.
+    """
+    t10_arr = np.asarray(t10_percent, dtype=float)
+    x_arr = np.asarray(x, dtype=float)
+    log_anchor, passing_anchor = _passing_anchors(t10_arr.reshape(-1), beta_params)
+    lam = fines_exponent(t10_arr.reshape(-1), beta_params)
+    log_x = np.log(np.clip(x_arr.reshape(-1), 1e-300, None))
+    out = np.empty((passing_anchor.shape[0], log_x.size))
+    for i in range(passing_anchor.shape[0]):
+        row = np.interp(log_x, log_anchor, passing_anchor[i])
+        below = log_x < log_anchor[0]
+        row[below] = passing_anchor[i, 0] * np.exp(lam[i] * (log_x[below] - log_anchor[0]))
+        out[i] = row
+    out[:, x_arr.reshape(-1) <= 0.0] = 0.0
+    out[:, x_arr.reshape(-1) >= 1.0] = 100.0
+    shape = t10_arr.shape + x_arr.shape
+    return out.reshape(shape)[()] if shape == () else out.reshape(shape)
+
+
+# --------------------------------------------------------------------------- Section 7, Eqs. 11-13
+@dataclass(frozen=True)
+class SizeDistribution:
+    """A cumulative product size distribution: mass (kg) finer than or equal to each size (m)."""
+
+    sizes: np.ndarray
+    passing_mass: np.ndarray
+    total_mass: float
+
+    @property
+    def passing_percent(self):
+        """Cumulative mass percent passing each size."""
+        return 100.0 * self.passing_mass / self.total_mass
+
+
+def size_distribution(sizes, resolved=None, dummies=None, unbreakable=None, beta_params=None):
+    """Section 7 (Eqs. 11-13): the full product size distribution after a run.
+
+    sizes: the sieve sizes (m) at which the cumulative passing mass is wanted.
+    resolved: (diameters m, masses kg) of resolved spheres, counted at their own size.
+    dummies: (masses kg, parent diameters m, event t10' %): each dummy mass is the event's
+        unresolved fines below X_MIN of its parent, spread by Eq. 11 with lambda from Eq. 12.
+    unbreakable: (diameters m, masses kg, t10' %) of resolved-unbreakable spheres: each is spread
+        by Eq. 13 (Eq. 10 at its recorded t10'); a NaN t10' (never stressed to breakage) keeps it
+        at its own size.
+    beta_params: the material's incomplete-beta parameters (needed for dummies and unbreakable).
+    Mass is conserved: passing at a size above every particle equals the total mass.
+    """
+    sizes = np.atleast_1d(np.asarray(sizes, dtype=float))
+    passing = np.zeros(sizes.shape)
+    total = 0.0
+    if resolved is not None:
+        diam, mass = (np.atleast_1d(np.asarray(a, dtype=float)) for a in resolved)
+        order = np.argsort(diam)
+        cum = np.concatenate([[0.0], np.cumsum(mass[order])])
+        passing += cum[np.searchsorted(diam[order], sizes, side="right")]
+        total += float(mass.sum())
+    if (dummies is not None or unbreakable is not None) and beta_params is None:
+        raise ValueError("size_distribution: beta_params is required to spread dummy and "
+                         "unbreakable masses")
+    if dummies is not None:
+        mass, parent, t10_event = (np.atleast_1d(np.asarray(a, dtype=float)) for a in dummies)
+        if mass.size:
+            lam = fines_exponent(t10_event, beta_params)
+            frac = fines_passing(sizes[None, :], X_MIN * parent[:, None], lam[:, None])
+            passing += mass @ frac
+            total += float(mass.sum())
+    if unbreakable is not None:
+        diam, mass, t10_rec = (np.atleast_1d(np.asarray(a, dtype=float)) for a in unbreakable)
+        if mass.size:
+            stressed = np.isfinite(t10_rec)
+            if np.any(~stressed):
+                order = np.argsort(diam[~stressed])
+                cum = np.concatenate([[0.0], np.cumsum(mass[~stressed][order])])
+                passing += cum[np.searchsorted(diam[~stressed][order], sizes, side="right")]
+            for d, m, t in zip(diam[stressed], mass[stressed], t10_rec[stressed]):
+                passing += m * progeny_passing(t, beta_params, sizes / d) / 100.0
+            total += float(mass.sum())
+    return SizeDistribution(sizes=sizes, passing_mass=passing, total_mass=total)
