@@ -1,0 +1,778 @@
+"""The YADE coupling: the only module that imports yade.
+
+`attach()` registers a PyRunner after the InteractionLoop. Each step it reads, for every real
+interaction that involves a tracked breakable body, the overlap and the total normal force
+(elastic plus dashpot, YADE's `normalForce` after Law2_ScGeom_MindlinPhys_Mindlin) and integrates
+Eqs. 15-16 by the trapezoidal rule while the overlap grows. A body's energy is Eq. 14,
+Ek' = sum e_c (En_c + cs Es_c) over its current contacts with energy >= emin, e_c from Eq. 4.
+It breaks when Ek'/m > E; otherwise, when its stressing event ends, it is weakened (Eqs. 5-6).
+
+A stressing event of a body opens when its Ek' reaches emin. It ends, without breakage, when the
+body has unloaded: its Ek' did not grow this step and the elastic energy now stored in its
+counted contacts (its share, 0.4 kno delta^2.5 for Hertz) is below emin; a contact that ceases
+drops out at once. A body in lasting contact (a bed under gravity) therefore closes its event when
+the load is removed, and starts the next from the contact state it is left in.
+
+On breakage (replace=True) the sphere is erased and a family of spheres (families.py) inserted
+inside it, with exact mass and momentum; the sibling overlaps are zeroed through a second PyRunner
+before the InteractionLoop that scales kno and kso so that only overlap beyond the artificial one
+produces Hertz-Mindlin force (see ../shared/YADE.md).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import time
+import warnings
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+import yade.wrapper as _wrapper
+from yade import O, utils
+
+from . import families, model, placement
+from .materials import Material, MaterialError, load_material
+
+_REGISTRY: dict[str, "Breakage"] = {}
+_TAG = "yadebreak:"
+
+
+class AttachError(RuntimeError):
+    """A scene that yadebreak cannot work with; the message says what to change."""
+
+
+# ------------------------------------------------------------------------------- scene materials
+def _frict_material(mat: Material, label: str, stiffness_scale: float = 1.0):
+    contact = mat.contacts.get("self") or next(iter(mat.contacts.values()), None)
+    friction = contact.friction if contact else 0.5
+    return _wrapper.FrictMat(young=mat.young_modulus * stiffness_scale, poisson=mat.poisson_ratio,
+                             density=mat.density, frictionAngle=math.atan(friction), label=label)
+
+
+def add_materials(labels, stiffness_scale=1.0):
+    """Create one YADE FrictMat per label from material files and return the Hertz-Mindlin
+    Ip2 functor with restitution and friction per pair (paper Table 6) through MatchMaker.
+
+    labels: {"ore": "copper_ore", "steel": "steel"}. stiffness_scale multiplies every Young's
+    modulus, which keeps the ratios of Eq. 4. Returns (ip2, {label: Material}).
+    """
+    mats = {}
+    ids = {}
+    for label, name in labels.items():
+        mat = name if isinstance(name, Material) else load_material(name)
+        mats[label] = mat
+        ids[label] = O.materials.append(_frict_material(mat, label, stiffness_scale))
+    en, es, fr = [], [], []
+    for la in labels:
+        for lb in labels:
+            if ids[la] > ids[lb]:
+                continue
+            try:
+                c = mats[la].contact_with(mats[lb])
+            except KeyError as exc:
+                raise AttachError(str(exc.args[0])) from None
+            en.append((ids[la], ids[lb], c.restitution))
+            es.append((ids[la], ids[lb], c.restitution))
+            fr.append((ids[la], ids[lb], math.atan(c.friction)))
+    ip2 = _wrapper.Ip2_FrictMat_FrictMat_MindlinPhys(
+        en=_wrapper.MatchMaker(matches=en), es=_wrapper.MatchMaker(matches=es),
+        frictAngle=_wrapper.MatchMaker(matches=fr))
+    return ip2, mats
+
+
+# ------------------------------------------------------------------------------- per-body state
+@dataclass
+class BodyState:
+    """What yadebreak keeps for one sphere it tracks (breakable, unbreakable or dummy)."""
+
+    kind: str                      # "breakable", "unbreakable", "dummy" or "broken"
+    material: str                  # YADE material label
+    mass: float                    # kg
+    radius: float                  # m
+    fracture_energy: float = math.inf   # J/kg, current (after damage)
+    fracture_energy_initial: float = math.inf
+    damage: float = 0.0            # accumulated: 1 - E / E_initial
+    specific_energy: float = 0.0   # Ek'/m now, J/kg
+    event_max: float = 0.0         # largest Ek' (J) of the open stressing event
+    t10: float = math.nan          # unbreakable: t10' of the first event that would have broken it;
+                                   # dummy: t10' of the event that made it
+    parent_size: float = math.nan  # dummy: the parent's diameter (m)
+    generation: int = 0
+
+    def as_dict(self):
+        return asdict(self)
+
+
+@dataclass
+class Options:
+    cs: float = 0.0
+    emin: float = 1e-4
+    kappa: float | None = None
+    emax_ratio: float | None = None
+    replace: bool = True
+    dmin: float | None = None
+    local_damping: float = 0.0
+    global_damping: float = 0.0
+    global_damping_time: float = 0.0
+    time_step_fraction: float | None = 0.05
+    event_log: str | None = None
+    seed: int = 0
+    read_period: int = 1
+    family_seed: int = 0
+
+
+# ------------------------------------------------------------------------------- the controller
+class Breakage:
+    """The controller returned by attach(): state, events, and results of one scene."""
+
+    def __init__(self, label, materials, options: Options):
+        self.label = label
+        self.options = options
+        self.material_names = dict(materials)
+        self.rng = np.random.default_rng(options.seed)
+        self.bodies: dict[int, BodyState] = {}
+        self.tracked: dict[int, BodyState] = {}    # breakable + unbreakable awaiting their t10'
+        self.open_events: set[int] = set()         # tracked bodies with an open stressing event
+        self.contacts: dict[tuple, list] = {}
+        self.zeroed: dict[tuple, float] = {}       # sibling pair -> artificial overlap (m)
+        self.damped_until: list[tuple] = []        # (time, [ids]) of fresh fragments
+        self.events: list[dict] = []
+        self.last_iter = -1
+        self.warned: set[str] = set()
+        self.top_size = 0.0
+        self.wall_time = {"read": 0.0, "replace": 0.0}
+        self._resolve_materials()
+        self._log = None
+
+    # -- set-up -------------------------------------------------------------------------------
+    def _resolve_materials(self):
+        labels = {m.label: m for m in O.materials}
+        unknown = [lab for lab in self.material_names if lab not in labels]
+        if unknown:
+            raise AttachError(
+                f"unknown YADE material label(s) {unknown}: the scene has "
+                f"{sorted(l for l in labels if l) or 'no labelled materials'}; give each breakable "
+                f"material a label (FrictMat(..., label='ore')) and map it in attach(materials=...)")
+        self.material = {}                          # label -> Material
+        for lab, name in self.material_names.items():
+            mat = name if isinstance(name, Material) else load_material(name)
+            if not mat.breakable:
+                raise AttachError(f"material '{mat.name}' (label '{lab}') is not breakable: map only "
+                                  "breakable materials in attach(materials=...)")
+            opts = self.options
+            if opts.kappa is not None or opts.emax_ratio is not None:
+                import dataclasses
+                mat = dataclasses.replace(mat, **{k: v for k, v in (
+                    ("kappa", opts.kappa), ("emax_ratio", opts.emax_ratio)) if v is not None})
+            self.material[lab] = mat
+        self.material_by_id = {}                    # YADE material id -> (label, Material)
+        self.stiffness_by_id = {}                   # YADE material id -> Hertz stiffness (Pa)
+        for m in O.materials:
+            young = getattr(m, "young", None)
+            poisson = getattr(m, "poisson", 0.0)
+            self.stiffness_by_id[m.id] = (math.inf if young is None
+                                          else float(model.hertz_stiffness(young, poisson)))
+            if m.label in self.material:
+                self.material_by_id[m.id] = (m.label, self.material[m.label])
+        self.tables = {lab: families.table_for(mat, self.options.family_seed)
+                       for lab, mat in self.material.items()}
+
+    def _register_bodies(self, ids=None):
+        """Give every breakable sphere (or the given ids) its state and fracture energy."""
+        found = []
+        problems = []
+        for b in (O.bodies if ids is None else (O.bodies[i] for i in ids)):
+            if b is None or b.id in self.bodies:
+                continue
+            mid = b.material.id if b.material is not None else None
+            if mid not in self.material_by_id:
+                continue
+            label = self.material_by_id[mid][0]
+            if not isinstance(b.shape, _wrapper.Sphere):
+                problems.append(f"body {b.id} ({type(b.shape).__name__}) has the breakable material "
+                                f"'{label}' but only spheres can break: give it another material")
+                continue
+            if b.isClumpMember or b.isClump:
+                problems.append(f"body {b.id} is part of a clump and has the breakable material "
+                                f"'{label}': clumps cannot break; use loose spheres")
+                continue
+            found.append(b)
+        if problems:
+            raise AttachError("; ".join(problems))
+        if not found:
+            return []
+        sizes = np.array([2.0 * b.shape.radius for b in found])
+        order = np.argsort([b.id for b in found], kind="stable")   # draws in id order: reproducible
+        energies = np.empty(len(found))
+        by_label = {}
+        for k in order:
+            by_label.setdefault(self.material_by_id[found[k].material.id][0], []).append(k)
+        for label, idx in by_label.items():
+            energies[idx] = self.material[label].sample_fracture_energy(self.rng, sizes[idx])
+        for k, b in enumerate(found):
+            label = self.material_by_id[b.material.id][0]
+            st = BodyState(kind="breakable", material=label, mass=b.state.mass,
+                           radius=b.shape.radius, fracture_energy=float(energies[k]),
+                           fracture_energy_initial=float(energies[k]))
+            self._adopt(b, st)
+        self.top_size = max(self.top_size, float(sizes.max()))
+        return found
+
+    def _adopt(self, body, st):
+        self.bodies[body.id] = st
+        if st.kind in ("breakable", "unbreakable"):
+            self.tracked[body.id] = st
+        body.breakage = st                      # readable on the body while the scene lives
+
+    # -- public API ------------------------------------------------------------------------------
+    def body_state(self, body_id):
+        """State of a tracked body as a dict (fracture_energy, damage, kind, specific_energy...)."""
+        return self.bodies[body_id].as_dict()
+
+    @property
+    def breakage_events(self):
+        return [e for e in self.events if e["kind"] == "breakage"]
+
+    def size_distribution(self, sizes, fines=True):
+        """The product size distribution (model.SizeDistribution, MODEL.md Section 7).
+
+        fines=True spreads dummy and unbreakable masses (Eqs. 11-13); fines=False counts every
+        sphere at its own size, as in the paper's Fig. 13.
+        """
+        resolved_d, resolved_m = [], []
+        groups = {}
+        for bid, st in self.bodies.items():
+            if st.kind == "broken":
+                continue
+            g = groups.setdefault(st.material, {"dummy": ([], [], []), "unb": ([], [], [])})
+            if fines and st.kind == "dummy":
+                for lst, v in zip(g["dummy"], (st.mass, st.parent_size, st.t10)):
+                    lst.append(v)
+            elif fines and st.kind == "unbreakable":
+                for lst, v in zip(g["unb"], (2 * st.radius, st.mass, st.t10)):
+                    lst.append(v)
+            else:
+                resolved_d.append(2 * st.radius)
+                resolved_m.append(st.mass)
+        sizes = np.atleast_1d(np.asarray(sizes, dtype=float))
+        passing = np.zeros(sizes.shape)
+        total = 0.0
+        sd = model.size_distribution(sizes, resolved=(resolved_d, resolved_m))
+        passing += sd.passing_mass
+        total += sd.total_mass
+        for label, g in groups.items():
+            sd = model.size_distribution(sizes, dummies=g["dummy"], unbreakable=g["unb"],
+                                         beta_params=self.material[label].beta_params)
+            passing += sd.passing_mass
+            total += sd.total_mass
+        return model.SizeDistribution(sizes, passing, total)
+
+    def total_mass(self):
+        """Mass (kg) of every body yadebreak knows, fragments included (the broken excluded)."""
+        return float(sum(st.mass for st in self.bodies.values() if st.kind != "broken"))
+
+    # -- event log -------------------------------------------------------------------------------
+    def _record(self, event):
+        self.events.append(event)
+        if self.options.event_log:
+            if self._log is None:
+                Path(self.options.event_log).parent.mkdir(parents=True, exist_ok=True)
+                self._log = open(self.options.event_log, "a", buffering=1)
+            self._log.write(json.dumps(event) + "\n")
+            self._log.flush()
+
+    def _warn_once(self, cause, message):
+        if cause not in self.warned:
+            self.warned.add(cause)
+            warnings.warn(f"yadebreak: {message}", RuntimeWarning, stacklevel=3)
+            print(f"[yadebreak] WARNING: {message}", file=sys.stderr, flush=True)
+
+    # -- the per-step work -------------------------------------------------------------------------
+    def step(self):
+        t0 = time.perf_counter()
+        opts = self.options
+        emin = opts.emin
+        cs = opts.cs
+        tracked = self.tracked
+        contacts = self.contacts
+        stiff = self.stiffness_by_id
+        seen = {}
+        energy = {}               # body -> Ek' (counted)
+        elastic = {}              # body -> stored elastic share of counted contacts
+        strongest = {}            # body -> (share energy, key) of its most energetic contact
+        touching = {}             # tracked body -> [(contact record, offset slot)]
+        grew = set()
+        bodies = O.bodies
+        for i in O.interactions:
+            a = i.id1
+            b = i.id2
+            ta = tracked.get(a)
+            tb = tracked.get(b)
+            if ta is None and tb is None:
+                continue
+            g = i.geom
+            if g is None:
+                continue
+            key = (a, b)
+            delta = g.penetrationDepth
+            force = i.phys.normalForce.dot(g.normal)
+            c = contacts.get(key)
+            if c is None:
+                ph = i.phys
+                ka = stiff[bodies[a].material.id]
+                kb = stiff[bodies[b].material.id]
+                # [delta, force, En, offset_a, offset_b, kno, e_a, e_b, us, Fs, Es]
+                c = [0.0, 0.0, 0.0, 0.0, 0.0, ph.kno,
+                     1.0 / (1.0 + ka / kb), 1.0 / (1.0 + kb / ka), 0.0, 0.0, 0.0]
+                contacts[key] = c
+            if delta > c[0]:
+                c[2] += 0.5 * (c[1] + force) * (delta - c[0])
+                if ta is not None:
+                    grew.add(a)
+                if tb is not None:
+                    grew.add(b)
+            c[0] = delta
+            c[1] = force
+            if cs > 0.0:
+                ph = i.phys
+                us = ph.usTotal.norm()
+                fs = ph.shearForce.norm()
+                if us > c[8]:
+                    c[10] += 0.5 * (c[9] + fs) * (us - c[8])
+                c[8] = us
+                c[9] = fs
+            seen[key] = c
+            total = c[2] + cs * c[10]
+            stored = 0.4 * c[5] * max(delta, 0.0) ** 2.5
+            if ta is not None:
+                touching.setdefault(a, []).append((c, 3))
+                own = total - c[3]
+                if own >= emin:
+                    share = c[6] * own
+                    energy[a] = energy.get(a, 0.0) + share
+                    elastic[a] = elastic.get(a, 0.0) + c[6] * stored
+                    if share > strongest.get(a, (0.0,))[0]:
+                        strongest[a] = (share, key)
+            if tb is not None:
+                touching.setdefault(b, []).append((c, 4))
+                own = total - c[4]
+                if own >= emin:
+                    share = c[7] * own
+                    energy[b] = energy.get(b, 0.0) + share
+                    elastic[b] = elastic.get(b, 0.0) + c[7] * stored
+                    if share > strongest.get(b, (0.0,))[0]:
+                        strongest[b] = (share, key)
+        self.contacts = seen                  # ceased contacts drop out
+        self.wall_time["read"] += time.perf_counter() - t0
+
+        broken = []
+        open_events = self.open_events
+        for bid in list(open_events.union(energy)):
+            st = tracked.get(bid)
+            if st is None:
+                open_events.discard(bid)
+                continue
+            ek = energy.get(bid, 0.0)
+            specific = ek / st.mass
+            if specific > st.fracture_energy:
+                if specific - st.specific_energy > 0.8 * st.fracture_energy and st.specific_energy > 0:
+                    self._warn_once("jump", (
+                        f"specific energy rose by {100 * (specific - st.specific_energy) / st.fracture_energy:.0f} % "
+                        f"of the fracture energy in one step at body {bid}: reduce the time step "
+                        f"(time_step_fraction) for an accurate t10'"))
+                st.specific_energy = specific
+                broken.append((bid, st, ek, strongest.get(bid)))
+                continue
+            st.specific_energy = specific
+            if ek > st.event_max:
+                st.event_max = ek
+                open_events.add(bid)
+            elif (st.event_max > 0.0 and bid not in grew and elastic.get(bid, 0.0) <= emin):
+                self._close_event(bid, st, touching.get(bid, ()))
+        if broken:
+            self._break_all(broken, seen)
+        self._release_damping()
+        self.last_iter = O.iter
+
+    def _close_event(self, bid, st, touching):
+        """End of a stressing event without breakage: Eqs. 5-6 with the event's largest Ek'."""
+        ratio = st.event_max / (st.mass * st.fracture_energy)
+        before = st.fracture_energy
+        if st.kind == "breakable":
+            after = float(model.weakened_fracture_energy(before, ratio, self.material[st.material].gamma))
+            st.fracture_energy = after
+            st.damage = 1.0 - after / st.fracture_energy_initial
+            self._record({"kind": "damage", "iter": O.iter, "time": O.time, "id": bid,
+                          "radius": st.radius, "mass": st.mass,
+                          "specific_energy": st.event_max / st.mass, "fracture_energy": before,
+                          "fracture_energy_after": after, "ratio": ratio})
+        st.event_max = 0.0
+        st.specific_energy = 0.0
+        self.open_events.discard(bid)
+        for c, slot in touching:            # the next event starts from the present state
+            c[slot] = c[2] + self.options.cs * c[10]
+
+    # -- breakage and replacement ----------------------------------------------------------------
+    def _break_all(self, broken, contacts):
+        t0 = time.perf_counter()
+        for bid, st, ek, strongest in broken:
+            if bid not in self.tracked:
+                continue
+            mat = self.material[st.material]
+            ratio = ek / (st.mass * st.fracture_energy)
+            t10 = float(model.t10(ratio, mat.A, mat.b_prime, mat.kappa))
+            if st.kind == "unbreakable":
+                st.t10 = t10                       # keeps the t10' of its first would-be breakage
+                del self.tracked[bid]
+                self._record({"kind": "unbreakable_stressed", "iter": O.iter, "time": O.time,
+                              "id": bid, "radius": st.radius, "mass": st.mass,
+                              "specific_energy": ek / st.mass,
+                              "fracture_energy": st.fracture_energy, "t10": t10})
+                continue
+            event = {"kind": "breakage", "iter": O.iter, "time": O.time, "id": bid,
+                     "radius": st.radius, "mass": st.mass, "specific_energy": ek / st.mass,
+                     "fracture_energy": st.fracture_energy, "ratio": ratio, "t10": t10,
+                     "generation": st.generation, "fragments": []}
+            del self.tracked[bid]
+            st.kind = "broken"
+            if self.options.replace:
+                direction = self._load_direction(bid, strongest)
+                event["fragments"], event["family_t10"] = self._replace(bid, st, t10, direction)
+            self._record(event)
+        self.wall_time["replace"] += time.perf_counter() - t0
+
+    def _load_direction(self, bid, strongest):
+        """Unit vector from the body's centre towards its most energetic contact."""
+        if strongest is None:
+            return np.array([0.0, 0.0, 1.0])
+        a, b = strongest[1]
+        i = O.interactions[a, b]
+        normal = np.array(i.geom.normal)          # from id1 towards id2
+        return -normal if bid == b else normal
+
+    def _replace(self, bid, st, t10, direction):
+        body = O.bodies[bid]
+        opts = self.options
+        table = self.tables[st.material]
+        fam = table.draw(self.rng, t10)
+        center = np.array(body.state.pos)
+        radius = st.radius
+        radii = fam.relative_sizes * radius
+        centers = placement.place_fragments(center, radius, radii, direction, self.rng)
+        masses = placement.fragment_masses(st.mass, radii)
+        vel = placement.fragment_velocities(centers, masses, center, np.array(body.state.vel),
+                                            np.array(body.state.angVel))
+        angvel = body.state.angVel
+        material = body.material
+        mat = self.material[st.material]
+        dmin = opts.dmin if opts.dmin is not None else self.top_size / 20.0
+        O.bodies.erase(bid)
+        new_ids = []
+        new_bodies = []
+        breakable_idx = []
+        for k in range(len(radii)):
+            b = utils.sphere(tuple(centers[k]), float(radii[k]), material=material)
+            b.state.mass = float(masses[k])
+            inertia = 0.4 * float(masses[k]) * float(radii[k]) ** 2
+            b.state.inertia = (inertia, inertia, inertia)
+            b.state.vel = tuple(vel[k])
+            b.state.angVel = angvel
+            if opts.global_damping > 0.0:
+                b.state.isDamped = True
+            new_bodies.append(b)
+        ids = O.bodies.append(new_bodies)
+        for k, nid in enumerate(ids):
+            if fam.is_dummy[k]:
+                kind = "dummy"
+            elif model.X_MIN * 2.0 * radii[k] < dmin:
+                kind = "unbreakable"
+            else:
+                kind = "breakable"
+                breakable_idx.append(k)
+            fs = BodyState(kind=kind, material=st.material, mass=float(masses[k]),
+                           radius=float(radii[k]), generation=st.generation + 1)
+            if kind == "dummy":
+                fs.t10, fs.parent_size = t10, 2.0 * radius
+            self.bodies[nid] = fs
+            new_ids.append(nid)
+        # fracture energies at the fragments' own sizes (unbreakable ones too: their first
+        # would-be breakage gives the t10' they keep)
+        need = [k for k in range(len(ids)) if self.bodies[ids[k]].kind != "dummy"]
+        if need:
+            energies = mat.sample_fracture_energy(self.rng, 2.0 * radii[need])
+            for k, e in zip(need, energies):
+                fs = self.bodies[ids[k]]
+                fs.fracture_energy = fs.fracture_energy_initial = float(e)
+        for k, nid in enumerate(ids):
+            self._adopt(O.bodies[nid], self.bodies[nid])
+        # zero the artificial sibling overlaps
+        ii, jj, overlap = placement.overlapping_pairs(centers, radii)
+        keep = 1.0 - opts.local_damping
+        for a, b, ov in zip(ii, jj, overlap):
+            ida, idb = ids[a], ids[b]
+            inter = utils.createInteraction(ida, idb)
+            ph = inter.phys
+            key = (min(ida, idb), max(ida, idb))
+            self.zeroed[key] = [keep * float(ov), ph.kno, ph.kso]
+        if self.zeroed:
+            self._zero_engine().dead = False
+        if opts.global_damping > 0.0:
+            self.damped_until.append((O.time + opts.global_damping_time, list(ids)))
+        if opts.time_step_fraction:
+            tr = placement.rayleigh_time(radii.min(), material.density, material.young,
+                                         material.poisson)
+            if opts.time_step_fraction * tr < O.dt:
+                O.dt = float(opts.time_step_fraction * tr)
+        return new_ids, fam.t10
+
+    def _zero_engine(self):
+        return _find_engine(self.label + "_zero")
+
+    def zero_overlaps(self):
+        """Before the InteractionLoop: kno, kso of zeroed sibling pairs scaled so that the Hertz
+        force is that of the overlap beyond the artificial one; the reference shrinks as the pair
+        opens and is dropped when it separates."""
+        if not self.zeroed:
+            self._zero_engine().dead = True
+            return
+        bodies = O.bodies
+        done = []
+        for key, z in self.zeroed.items():
+            ba = bodies[key[0]]
+            bb = bodies[key[1]]
+            if ba is None or bb is None:
+                done.append(key)
+                continue
+            dist = (ba.state.pos - bb.state.pos).norm()
+            d = ba.shape.radius + bb.shape.radius - dist
+            if d <= 0.0:
+                done.append(key)
+                continue
+            if d < z[0]:
+                z[0] = d
+            if not O.interactions.has(key[0], key[1]):
+                done.append(key)
+                continue
+            inter = O.interactions[key[0], key[1]]
+            if not inter.isReal:
+                done.append(key)
+                continue
+            ratio = (d - z[0]) / d
+            ph = inter.phys
+            ph.kno = z[1] * ratio ** 1.5
+            ph.kso = z[2] * ratio ** 0.5
+        for key in done:
+            del self.zeroed[key]
+
+    def _release_damping(self):
+        if not self.damped_until:
+            return
+        now = O.time
+        keep = []
+        for until, ids in self.damped_until:
+            if now >= until:
+                for i in ids:
+                    b = O.bodies[i]
+                    if b is not None:
+                        b.state.isDamped = False
+            else:
+                keep.append((until, ids))
+        self.damped_until = keep
+
+    # -- persistence -------------------------------------------------------------------------------
+    def state_dict(self):
+        return {"label": self.label, "options": asdict(self.options),
+                "materials": {k: (v.source if isinstance(v, Material) else v)
+                              for k, v in self.material_names.items()},
+                "rng": self.rng.bit_generator.state, "iter": O.iter, "top_size": self.top_size,
+                "bodies": {str(k): v.as_dict() for k, v in self.bodies.items()},
+                "tracked": sorted(self.tracked),
+                "contacts": [[k[0], k[1], c] for k, c in self.contacts.items()],
+                "zeroed": [[k[0], k[1], z] for k, z in self.zeroed.items()],
+                "damped_until": self.damped_until, "events": self.events,
+                "warned": sorted(self.warned)}
+
+    def sync_tags(self):
+        """Write the whole state into O.tags, so that O.save keeps it (done by O.save itself)."""
+        O.tags[_TAG + self.label] = json.dumps(self.state_dict())
+
+    @classmethod
+    def from_tags(cls, label):
+        data = json.loads(O.tags[_TAG + label])
+        self = cls(label, data["materials"], Options(**data["options"]))
+        self.rng.bit_generator.state = data["rng"]
+        self.top_size = data["top_size"]
+        self.bodies = {int(k): BodyState(**v) for k, v in data["bodies"].items()}
+        self.tracked = {i: self.bodies[i] for i in data["tracked"]}
+        self.open_events = {i for i in data["tracked"] if self.bodies[i].event_max > 0.0}
+        self.contacts = {(a, b): c for a, b, c in data["contacts"]}
+        self.zeroed = {(a, b): z for a, b, z in data["zeroed"]}
+        self.damped_until = [tuple(x) for x in data["damped_until"]]
+        self.events = data["events"]
+        self.warned = set(data["warned"])
+        self.last_iter = data["iter"] - 1
+        for bid, st in self.bodies.items():
+            b = O.bodies[bid] if bid < len(O.bodies) else None
+            if b is not None:
+                b.breakage = st
+        if self.options.event_log:             # the log holds exactly the events of this state
+            path = Path(self.options.event_log)
+            tmp = path.with_suffix(".tmp")
+            tmp.write_text("".join(json.dumps(e) + "\n" for e in self.events))
+            os.replace(tmp, path)
+        return self
+
+    def close(self):
+        if self._log is not None:
+            self._log.close()
+            self._log = None
+
+
+def _find_engine(label):
+    for e in O.engines:
+        if getattr(e, "label", "") == label:
+            return e
+    return None
+
+
+def _controller(label):
+    ctl = _REGISTRY.get(label)
+    stale = ctl is None or O.iter <= ctl.last_iter or O.iter > ctl.last_iter + ctl.options.read_period
+    if stale and ctl is not None and ctl.last_iter < 0:
+        stale = False
+    if stale:
+        if _TAG + label not in O.tags.keys():
+            raise AttachError(f"yadebreak engine '{label}' has no state in this scene")
+        if ctl is not None:
+            ctl.close()
+        ctl = Breakage.from_tags(label)
+        _REGISTRY[label] = ctl
+    return ctl
+
+
+def _run(label):
+    """Called by the PyRunner after the InteractionLoop."""
+    _controller(label).step()
+
+
+def _run_zero(label):
+    """Called by the PyRunner before the InteractionLoop."""
+    ctl = _REGISTRY.get(label)
+    if ctl is None or O.iter <= ctl.last_iter or O.iter > ctl.last_iter + 1:
+        ctl = _controller(label)
+    ctl.zero_overlaps()
+
+
+# keep the state in O.tags whenever the scene is saved
+_original_save = _wrapper.Omega.save
+
+
+def _save_with_state(self, *args, **kwargs):
+    for ctl in _REGISTRY.values():
+        try:
+            ctl.sync_tags()
+        except Exception as exc:     # never lose the save itself
+            print(f"[yadebreak] could not store state in O.tags: {exc}", file=sys.stderr)
+    return _original_save(self, *args, **kwargs)
+
+
+if getattr(_wrapper.Omega.save, "__name__", "") != "_save_with_state":
+    _wrapper.Omega.save = _save_with_state
+
+
+# ------------------------------------------------------------------------------- attach
+def attach(materials, seed=0, *, label="yadebreak", **options):
+    """Register yadebreak in the current YADE scene and return its controller.
+
+    materials: {YADE material label: material name, path or Material}. Bodies of other materials
+    are non-breakable partners. Call after O.engines is set (an InteractionLoop with
+    Law2_ScGeom_MindlinPhys_Mindlin) and the breakable spheres exist.
+    Options: cs (0), emin (1e-4 J), kappa, emax_ratio (override the files), replace (True),
+    dmin (top size / 20), local_damping (0), global_damping (0), global_damping_time (0 s),
+    time_step_fraction (0.05 of the smallest sphere's Rayleigh time; None leaves O.dt),
+    event_log (a JSON-lines path), read_period (1: contacts read every step).
+    """
+    unknown = set(options) - set(Options.__dataclass_fields__) - {"seed"}
+    if unknown:
+        raise AttachError(f"unknown option(s) {sorted(unknown)}; accepted: "
+                          f"{sorted(set(Options.__dataclass_fields__) - {'seed', 'family_seed'})}")
+    opts = Options(seed=seed, **options)
+    _check_options(opts)
+    if label in _REGISTRY and _find_engine(label) is not None:
+        raise AttachError(f"yadebreak is already attached to this scene as '{label}': call attach "
+                          "once per scene (or give another label)")
+    engines = list(O.engines)
+    loop_idx = next((k for k, e in enumerate(engines) if isinstance(e, _wrapper.InteractionLoop)), None)
+    if loop_idx is None:
+        raise AttachError("O.engines has no InteractionLoop: set O.engines (with "
+                          "Law2_ScGeom_MindlinPhys_Mindlin) before calling yadebreak.attach")
+    laws = engines[loop_idx].lawDispatcher.functors
+    if not any(isinstance(f, _wrapper.Law2_ScGeom_MindlinPhys_Mindlin) for f in laws):
+        raise AttachError("the InteractionLoop has no Law2_ScGeom_MindlinPhys_Mindlin: yadebreak "
+                          "reads YADE's Hertz-Mindlin forces (use add_materials() for the Ip2)")
+    try:
+        ctl = Breakage(label, materials, opts)
+    except MaterialError as exc:
+        raise AttachError(str(exc)) from None
+    ctl._register_bodies()
+    if not ctl.bodies:
+        ctl._warn_once("empty", "the scene has no breakable body: nothing will break (materials "
+                       f"mapped: {sorted(materials)})")
+    if opts.global_damping > 0.0:
+        newton = next((e for e in engines if isinstance(e, _wrapper.NewtonIntegrator)), None)
+        if newton is not None:
+            newton.damping = opts.global_damping
+            for b in O.bodies:                 # global damping acts on fresh fragments only
+                if b is not None:
+                    b.state.isDamped = False
+    if opts.time_step_fraction:
+        radii = [(b.shape.radius, b.material) for b in O.bodies
+                 if b is not None and isinstance(b.shape, _wrapper.Sphere)]
+        if radii:
+            tr = min(float(placement.rayleigh_time(r, m.density, m.young, m.poisson))
+                     for r, m in radii)
+            O.dt = opts.time_step_fraction * tr
+    if opts.event_log:
+        Path(opts.event_log).parent.mkdir(parents=True, exist_ok=True)
+        open(opts.event_log, "w").close()
+    runner = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run({label!r})",
+                               iterPeriod=opts.read_period, label=label)
+    zero = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run_zero({label!r})",
+                             iterPeriod=1, label=label + "_zero", dead=True)
+    engines.insert(loop_idx + 1, runner)
+    engines.insert(loop_idx, zero)
+    O.engines = engines
+    ctl.last_iter = O.iter - 1
+    _REGISTRY[label] = ctl
+    ctl.sync_tags()
+    return ctl
+
+
+def _check_options(opts):
+    problems = []
+    if not (0.0 <= opts.cs <= 1.0):
+        problems.append(f"cs = {opts.cs}: accepted [0, 1]")
+    if not (opts.emin >= 0.0):
+        problems.append(f"emin = {opts.emin} J: accepted >= 0")
+    if opts.kappa is not None and not opts.kappa > 0:
+        problems.append(f"kappa = {opts.kappa}: accepted > 0")
+    if opts.emax_ratio is not None and not opts.emax_ratio > 1:
+        problems.append(f"emax_ratio = {opts.emax_ratio}: accepted > 1")
+    if opts.dmin is not None and not opts.dmin > 0:
+        problems.append(f"dmin = {opts.dmin} m: accepted > 0")
+    if not (0.0 <= opts.local_damping <= 1.0):
+        problems.append(f"local_damping = {opts.local_damping}: accepted [0, 1]")
+    if not (0.0 <= opts.global_damping < 1.0):
+        problems.append(f"global_damping = {opts.global_damping}: accepted [0, 1)")
+    if not opts.global_damping_time >= 0:
+        problems.append(f"global_damping_time = {opts.global_damping_time} s: accepted >= 0")
+    if opts.time_step_fraction is not None and not (0.0 < opts.time_step_fraction <= 1.0):
+        problems.append(f"time_step_fraction = {opts.time_step_fraction}: accepted (0, 1]")
+    if not (isinstance(opts.read_period, int) and opts.read_period >= 1):
+        problems.append(f"read_period = {opts.read_period}: accepted an integer >= 1")
+    if problems:
+        raise AttachError("bad option(s): " + "; ".join(problems))

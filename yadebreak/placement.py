@@ -1,0 +1,114 @@
+"""Where fragments go inside their parent and how they move (MODEL.md Section 8). Never imports yade.
+
+Coarse fragments are laid side by side across the direction of the stress that broke the parent
+(the normal of its most energetic contact); finer ones fill the remaining room, nearer the loaded
+point. Every fragment lies inside the parent's sphere. Velocities follow the parent's rigid-body
+field v + w x r, corrected so that the total linear momentum is the parent's exactly.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+#: Fragments at least this large (relative to the parent) are "coarse": laid across the load.
+COARSE_RELATIVE_SIZE = 0.45
+_CANDIDATES = 12
+
+
+def _perpendicular_basis(direction):
+    n = np.asarray(direction, dtype=float)
+    norm = np.linalg.norm(n)
+    n = np.array([0.0, 0.0, 1.0]) if not np.isfinite(norm) or norm == 0 else n / norm
+    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(n, helper)
+    u /= np.linalg.norm(u)
+    return n, u, np.cross(n, u)
+
+
+def place_fragments(center, radius, fragment_radii, load_direction, rng):
+    """Centres (k x 3, metres) for fragments of the given radii inside a parent sphere.
+
+    center, radius: the parent's; load_direction: unit vector from the parent's centre towards the
+    loaded point (the most energetic contact). Fragments are handled largest first. Coarse ones
+    (radius >= 0.45 R) go in the plane through the centre normal to the load, spread at equal
+    angles and pushed out to touch the parent's surface; each finer one takes, among a few random
+    points inside the parent, the one that overlaps the spheres already placed least, with ties
+    broken towards the loaded point. Every centre satisfies |c - center| <= R - r.
+    """
+    center = np.asarray(center, dtype=float)
+    radii = np.asarray(fragment_radii, dtype=float)
+    n, u, w = _perpendicular_basis(load_direction)
+    order = np.argsort(-radii, kind="stable")
+    out = np.empty((len(radii), 3))
+    coarse = [i for i in order if radii[i] >= COARSE_RELATIVE_SIZE * radius]
+    phase = rng.uniform(0.0, 2.0 * np.pi)
+    for j, i in enumerate(coarse):
+        angle = phase + 2.0 * np.pi * j / len(coarse)
+        reach = radius - radii[i]
+        out[i] = center + reach * (np.cos(angle) * u + np.sin(angle) * w)
+    placed_c = [out[i] for i in coarse]
+    placed_r = [radii[i] for i in coarse]
+    for i in order[len(coarse):]:
+        reach = max(radius - radii[i], 0.0)
+        # random points in the ball of radius `reach`, the first one on the loaded side
+        dirs = rng.normal(size=(_CANDIDATES, 3))
+        dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+        dist = reach * rng.random(_CANDIDATES) ** (1.0 / 3.0)
+        cand = center + dirs * dist[:, None]
+        cand[0] = center + n * reach * rng.random()
+        if placed_c:
+            pc = np.array(placed_c)
+            pr = np.array(placed_r)
+            gap = np.linalg.norm(cand[:, None, :] - pc[None, :, :], axis=2) - (pr[None, :] + radii[i])
+            overlap = np.clip(-gap, 0.0, None).sum(axis=1)
+        else:
+            overlap = np.zeros(_CANDIDATES)
+        toward_load = (cand - center) @ n
+        score = overlap - 1e-3 * radius * toward_load / max(reach, 1e-300)
+        best = int(np.argmin(score))
+        out[i] = cand[best]
+        placed_c.append(out[i])
+        placed_r.append(radii[i])
+    # guard against round-off pushing a centre a hair outside the parent
+    offset = out - center
+    dist = np.linalg.norm(offset, axis=1)
+    limit = np.maximum(radius - radii, 0.0)
+    too_far = dist > limit
+    if np.any(too_far):
+        out[too_far] = center + offset[too_far] * (limit[too_far] / dist[too_far])[:, None]
+    return out
+
+
+def fragment_velocities(centers, masses, parent_center, velocity, angular_velocity):
+    """Velocities (k x 3) from the parent's field v + w x (c - parent_center), shifted by a common
+    vector so that sum(m_i v_i) equals M v exactly (M = sum m_i, the parent's mass)."""
+    centers = np.asarray(centers, dtype=float)
+    masses = np.asarray(masses, dtype=float)
+    velocity = np.asarray(velocity, dtype=float)
+    omega = np.asarray(angular_velocity, dtype=float)
+    vel = velocity + np.cross(omega, centers - np.asarray(parent_center, dtype=float))
+    total = masses.sum()
+    correction = (total * velocity - masses @ vel) / total
+    return vel + correction
+
+
+def fragment_masses(parent_mass, fragment_radii):
+    """Masses proportional to r^3 summing to the parent's mass (exact to round-off)."""
+    vol = np.asarray(fragment_radii, dtype=float) ** 3
+    return parent_mass * vol / vol.sum()
+
+
+def overlapping_pairs(centers, radii):
+    """Index pairs (i < j) and their overlaps r_i + r_j - |c_i - c_j| > 0, among the fragments."""
+    centers = np.asarray(centers, dtype=float)
+    radii = np.asarray(radii, dtype=float)
+    i, j = np.triu_indices(len(radii), k=1)
+    overlap = radii[i] + radii[j] - np.linalg.norm(centers[i] - centers[j], axis=1)
+    keep = overlap > 0.0
+    return i[keep], j[keep], overlap[keep]
+
+
+def rayleigh_time(radius, density, young, poisson):
+    """Rayleigh time T_R = pi R sqrt(rho / G) / (0.1631 nu + 0.8766), G = Y / (2 (1 + nu)); SI."""
+    shear_modulus = np.asarray(young, dtype=float) / (2.0 * (1.0 + np.asarray(poisson, dtype=float)))
+    return np.pi * np.asarray(radius, dtype=float) * np.sqrt(density / shear_modulus) / (
+        0.1631 * np.asarray(poisson, dtype=float) + 0.8766)
