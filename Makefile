@@ -12,7 +12,7 @@ deps:
 	@if ! command -v yade >/dev/null 2>&1 || ! $(PY) -c "import pytest, numpy, scipy, matplotlib, yade" >/dev/null 2>&1; then \
 		echo "[yadebreak] installing YADE and Python packages from Debian (a few minutes, once)"; \
 		apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends \
-			yade python3-pytest python3-numpy python3-scipy python3-matplotlib; \
+			yade python3-yade python3-pytest python3-numpy python3-scipy python3-matplotlib; \
 	fi
 
 demo: deps

@@ -31,8 +31,12 @@ from pathlib import Path
 
 import numpy as np
 
-import yade.wrapper as _wrapper
-from yade import O, utils
+from .yadepath import ensure_yade_importable
+
+ensure_yade_importable()
+
+import yade.wrapper as _wrapper  # noqa: E402
+from yade import O, utils  # noqa: E402
 
 from . import families, model, placement
 from .materials import Material, MaterialError, load_material
@@ -303,7 +307,7 @@ class Breakage:
         seen = {}
         energy = {}               # body -> Ek' (counted)
         elastic = {}              # body -> stored elastic share of counted contacts
-        strongest = {}            # body -> (share energy, key) of its most energetic contact
+        strongest = {}            # body -> (share energy, normal, sign) of its most energetic contact
         touching = {}             # tracked body -> [(contact record, offset slot)]
         grew = set()
         bodies = O.bodies
@@ -356,7 +360,7 @@ class Breakage:
                     energy[a] = energy.get(a, 0.0) + share
                     elastic[a] = elastic.get(a, 0.0) + c[6] * stored
                     if share > strongest.get(a, (0.0,))[0]:
-                        strongest[a] = (share, key)
+                        strongest[a] = (share, g.normal, 1.0)      # normal points a -> b
             if tb is not None:
                 touching.setdefault(b, []).append((c, 4))
                 own = total - c[4]
@@ -365,7 +369,7 @@ class Breakage:
                     energy[b] = energy.get(b, 0.0) + share
                     elastic[b] = elastic.get(b, 0.0) + c[7] * stored
                     if share > strongest.get(b, (0.0,))[0]:
-                        strongest[b] = (share, key)
+                        strongest[b] = (share, g.normal, -1.0)
         self.contacts = seen                  # ceased contacts drop out
         self.wall_time["read"] += time.perf_counter() - t0
 
@@ -440,19 +444,11 @@ class Breakage:
             del self.tracked[bid]
             st.kind = "broken"
             if self.options.replace:
-                direction = self._load_direction(bid, strongest)
+                direction = (np.array([0.0, 0.0, 1.0]) if strongest is None
+                             else strongest[2] * np.array(strongest[1]))
                 event["fragments"], event["family_t10"] = self._replace(bid, st, t10, direction)
             self._record(event)
         self.wall_time["replace"] += time.perf_counter() - t0
-
-    def _load_direction(self, bid, strongest):
-        """Unit vector from the body's centre towards its most energetic contact."""
-        if strongest is None:
-            return np.array([0.0, 0.0, 1.0])
-        a, b = strongest[1]
-        i = O.interactions[a, b]
-        normal = np.array(i.geom.normal)          # from id1 towards id2
-        return -normal if bid == b else normal
 
     def _replace(self, bid, st, t10, direction):
         body = O.bodies[bid]
@@ -470,10 +466,15 @@ class Breakage:
         material = body.material
         mat = self.material[st.material]
         dmin = opts.dmin if opts.dmin is not None else self.top_size / 20.0
+        # the parent's neighbours and its real (force-producing) overlap with each
+        neighbours = []
+        for inter in O.interactions.withBody(bid):
+            other = inter.id2 if inter.id1 == bid else inter.id1
+            z = self.zeroed.get((min(bid, other), max(bid, other)))
+            real = inter.geom.penetrationDepth - (z[0] if z else 0.0)
+            neighbours.append((other, max(real, 0.0)))
         O.bodies.erase(bid)
-        new_ids = []
         new_bodies = []
-        breakable_idx = []
         for k in range(len(radii)):
             b = utils.sphere(tuple(centers[k]), float(radii[k]), material=material)
             b.state.mass = float(masses[k])
@@ -482,23 +483,22 @@ class Breakage:
             b.state.vel = tuple(vel[k])
             b.state.angVel = angvel
             if opts.global_damping > 0.0:
-                b.state.isDamped = True
+                b.state.isDamped = True        # global damping acts on fresh fragments only
             new_bodies.append(b)
         ids = O.bodies.append(new_bodies)
+        new_ids = list(ids)
         for k, nid in enumerate(ids):
             if fam.is_dummy[k]:
                 kind = "dummy"
             elif model.X_MIN * 2.0 * radii[k] < dmin:
-                kind = "unbreakable"
+                kind = "unbreakable"       # its own progeny would be finer than dmin
             else:
                 kind = "breakable"
-                breakable_idx.append(k)
             fs = BodyState(kind=kind, material=st.material, mass=float(masses[k]),
                            radius=float(radii[k]), generation=st.generation + 1)
             if kind == "dummy":
                 fs.t10, fs.parent_size = t10, 2.0 * radius
             self.bodies[nid] = fs
-            new_ids.append(nid)
         # fracture energies at the fragments' own sizes (unbreakable ones too: their first
         # would-be breakage gives the t10' they keep)
         need = [k for k in range(len(ids)) if self.bodies[ids[k]].kind != "dummy"]
@@ -507,17 +507,39 @@ class Breakage:
             for k, e in zip(need, energies):
                 fs = self.bodies[ids[k]]
                 fs.fracture_energy = fs.fracture_energy_initial = float(e)
-        for k, nid in enumerate(ids):
+        for nid in ids:
             self._adopt(O.bodies[nid], self.bodies[nid])
-        # zero the artificial sibling overlaps
+        # zero the artificial overlaps: between siblings entirely; with each neighbour of the
+        # parent, the child overlapping it most keeps the parent's real overlap as real force and
+        # everything beyond it is zeroed, while the other children's overlaps with that neighbour
+        # are zeroed entirely (else k children would each press with the parent's overlap and
+        # multiply the force the parent carried)
         ii, jj, overlap = placement.overlapping_pairs(centers, radii)
-        keep = 1.0 - opts.local_damping
         for a, b, ov in zip(ii, jj, overlap):
-            ida, idb = ids[a], ids[b]
-            inter = utils.createInteraction(ida, idb)
-            ph = inter.phys
-            key = (min(ida, idb), max(ida, idb))
-            self.zeroed[key] = [keep * float(ov), ph.kno, ph.kso]
+            self._zero_pair(ids[a], ids[b], float(ov), created=False)
+        for other, real in neighbours:
+            ob = O.bodies[other]
+            if ob is None:
+                continue
+            if isinstance(ob.shape, _wrapper.Sphere):
+                ov = radii + ob.shape.radius - np.linalg.norm(centers - np.array(ob.state.pos), axis=1)
+                created = False
+            else:                                # walls, facets: ask YADE's own geometry
+                ov = np.full(len(ids), -1.0)
+                for k in range(len(ids)):
+                    try:
+                        ov[k] = utils.createInteraction(ids[k], other).geom.penetrationDepth
+                    except Exception:
+                        continue
+                created = True
+            touching = np.nonzero(ov > 0.0)[0]
+            if len(touching) == 0:
+                continue
+            keeper = touching[np.argmax(ov[touching])]
+            for k in touching:
+                artificial = ov[k] - real if k == keeper else ov[k]
+                if artificial > 0.0:
+                    self._zero_pair(ids[k], other, float(artificial), created=created)
         if self.zeroed:
             self._zero_engine().dead = False
         if opts.global_damping > 0.0:
@@ -528,6 +550,15 @@ class Breakage:
             if opts.time_step_fraction * tr < O.dt:
                 O.dt = float(opts.time_step_fraction * tr)
         return new_ids, fam.t10
+
+    def _zero_pair(self, id_a, id_b, artificial, created):
+        """Register an artificial overlap (m) of a new pair; only (1 - local_damping) of it is
+        zeroed, the rest is released as real force."""
+        inter = O.interactions[id_a, id_b] if created else utils.createInteraction(id_a, id_b)
+        ph = inter.phys
+        key = (min(id_a, id_b), max(id_a, id_b))
+        # the zero engine scales kno, kso before the next force evaluation
+        self.zeroed[key] = [(1.0 - self.options.local_damping) * artificial, ph.kno, ph.kso]
 
     def _zero_engine(self):
         return _find_engine(self.label + "_zero")
@@ -544,23 +575,22 @@ class Breakage:
         for key, z in self.zeroed.items():
             ba = bodies[key[0]]
             bb = bodies[key[1]]
-            if ba is None or bb is None:
-                done.append(key)
-                continue
-            dist = (ba.state.pos - bb.state.pos).norm()
-            d = ba.shape.radius + bb.shape.radius - dist
-            if d <= 0.0:
-                done.append(key)
-                continue
-            if d < z[0]:
-                z[0] = d
-            if not O.interactions.has(key[0], key[1]):
+            if ba is None or bb is None or not O.interactions.has(key[0], key[1]):
                 done.append(key)
                 continue
             inter = O.interactions[key[0], key[1]]
             if not inter.isReal:
                 done.append(key)
                 continue
+            if isinstance(ba.shape, _wrapper.Sphere) and isinstance(bb.shape, _wrapper.Sphere):
+                d = ba.shape.radius + bb.shape.radius - (ba.state.pos - bb.state.pos).norm()
+            else:
+                d = inter.geom.penetrationDepth     # walls, facets: the last step's overlap
+            if d <= 0.0:
+                done.append(key)
+                continue
+            if d < z[0]:
+                z[0] = d
             ratio = (d - z[0]) / d
             ph = inter.phys
             ph.kno = z[1] * ratio ** 1.5

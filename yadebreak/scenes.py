@@ -5,10 +5,8 @@ import math
 
 import numpy as np
 
-import yade.wrapper as _w
-from yade import O, utils
-
-from .coupling import add_materials, attach
+# the coupling makes yade importable from Debian's python3 first
+from .coupling import O, _wrapper as _w, add_materials, attach, utils
 
 
 def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False):
