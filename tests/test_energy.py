@@ -119,3 +119,20 @@ def test_body_state_and_tags(scene):
     assert st["kind"] == "breakable" and st["damage"] == 0.0 and st["specific_energy"] == 0.0
     assert O.bodies[ids[0]].breakage.fracture_energy == st["fracture_energy"]
     assert "yadebreak:yadebreak" in O.tags.keys()
+
+
+@pytest.mark.parametrize("material, energy", [("copper_ore", 150.0), ("copper_ore", 400.0),
+                                              ("limestone", 60.0)])
+def test_single_impact_broken_fraction_within_3_binomial_sigma(scene, material, energy):
+    from yadebreak import scenes
+    n = 250
+    speed = (2 * energy) ** 0.5
+    brk, ids = scenes.impact_scene(material, 5.5e-3, speeds=[speed] * n, seed=11, replace=False)
+    scenes.run_until_rebound(ids)
+    broken = {e["id"] for e in brk.breakage_events}
+    fraction = len(broken & set(ids)) / n
+    mat = load_material(material)
+    p = float(mat.breakage_probability(energy, 5.5e-3, partner=load_material("steel")))
+    sigma = math.sqrt(p * (1 - p) / n)
+    assert 0.05 < p < 0.95
+    assert abs(fraction - p) <= 3 * sigma

@@ -127,6 +127,7 @@ class Options:
     seed: int = 0
     read_period: int = 1
     family_seed: int = 0
+    zero_overlaps: bool = True      # False only to show what the zeroing prevents
 
 
 # ------------------------------------------------------------------------------- the controller
@@ -237,15 +238,26 @@ class Breakage:
         """State of a tracked body as a dict (fracture_energy, damage, kind, specific_energy...)."""
         return self.bodies[body_id].as_dict()
 
+    def break_body(self, body_id, ratio=1.0, direction=(0.0, 0.0, 1.0)):
+        """Break a breakable body now, as if stressed to ratio = Ek'/(m E) (t10' from Eq. 8) along
+        `direction`. Returns the breakage event."""
+        st = self.tracked.get(body_id)
+        if st is None or st.kind != "breakable":
+            raise ValueError(f"body {body_id} is not a breakable body yadebreak tracks")
+        ek = ratio * st.mass * st.fracture_energy
+        self._break_all([(body_id, st, ek, (ek, direction, 1.0))], self.contacts)
+        return self.events[-1]
+
     @property
     def breakage_events(self):
         return [e for e in self.events if e["kind"] == "breakage"]
 
-    def size_distribution(self, sizes, fines=True):
+    def size_distribution(self, sizes, fines=True, fines_model="gaudin_schuhmann"):
         """The product size distribution (model.SizeDistribution, MODEL.md Section 7).
 
         fines=True spreads dummy and unbreakable masses (Eqs. 11-13); fines=False counts every
-        sphere at its own size, as in the paper's Fig. 13.
+        sphere at its own size, as in the paper's Fig. 13. fines_model: "gaudin_schuhmann" (the
+        paper's Eqs. 11-12) or "eq10" (see model.dummy_fines_passing).
         """
         resolved_d, resolved_m = [], []
         groups = {}
@@ -270,7 +282,8 @@ class Breakage:
         total += sd.total_mass
         for label, g in groups.items():
             sd = model.size_distribution(sizes, dummies=g["dummy"], unbreakable=g["unb"],
-                                         beta_params=self.material[label].beta_params)
+                                         beta_params=self.material[label].beta_params,
+                                         fines=fines_model)
             passing += sd.passing_mass
             total += sd.total_mass
         return model.SizeDistribution(sizes, passing, total)
@@ -423,6 +436,7 @@ class Breakage:
     # -- breakage and replacement ----------------------------------------------------------------
     def _break_all(self, broken, contacts):
         t0 = time.perf_counter()
+        self._pending_dt = math.inf
         for bid, st, ek, strongest in broken:
             if bid not in self.tracked:
                 continue
@@ -448,6 +462,7 @@ class Breakage:
                              else strongest[2] * np.array(strongest[1]))
                 event["fragments"], event["family_t10"] = self._replace(bid, st, t10, direction)
             self._record(event)
+        self._lower_time_step(self._pending_dt)
         self.wall_time["replace"] += time.perf_counter() - t0
 
     def _replace(self, bid, st, t10, direction):
@@ -515,6 +530,20 @@ class Breakage:
         # are zeroed entirely (else k children would each press with the parent's overlap and
         # multiply the force the parent carried)
         ii, jj, overlap = placement.overlapping_pairs(centers, radii)
+        if opts.zero_overlaps:
+            self._zero_new(ids, centers, radii, ii, jj, overlap, neighbours)
+        if self.zeroed:
+            self._zero_engine().dead = False
+        if opts.global_damping > 0.0:
+            self.damped_until.append((O.time + opts.global_damping_time, list(ids)))
+        if opts.time_step_fraction:
+            tr = placement.rayleigh_time(radii.min(), material.density, material.young,
+                                         material.poisson)
+            self._pending_dt = min(self._pending_dt, float(opts.time_step_fraction * tr))
+        return new_ids, fam.t10
+
+    def _zero_new(self, ids, centers, radii, ii, jj, overlap, neighbours):
+        """Zero the artificial overlaps of fresh fragments (see _replace)."""
         for a, b, ov in zip(ii, jj, overlap):
             self._zero_pair(ids[a], ids[b], float(ov), created=False)
         for other, real in neighbours:
@@ -540,16 +569,31 @@ class Breakage:
                 artificial = ov[k] - real if k == keeper else ov[k]
                 if artificial > 0.0:
                     self._zero_pair(ids[k], other, float(artificial), created=created)
-        if self.zeroed:
-            self._zero_engine().dead = False
-        if opts.global_damping > 0.0:
-            self.damped_until.append((O.time + opts.global_damping_time, list(ids)))
-        if opts.time_step_fraction:
-            tr = placement.rayleigh_time(radii.min(), material.density, material.young,
-                                         material.poisson)
-            if opts.time_step_fraction * tr < O.dt:
-                O.dt = float(opts.time_step_fraction * tr)
-        return new_ids, fam.t10
+
+    def _lower_time_step(self, new_dt):
+        """O.dt = new_dt, keeping the leapfrog exact across the change.
+
+        YADE's Newton takes v(n+1/2) = v(n-1/2) + a dt with the new dt; across a change the right
+        increment is a (dt_old + dt_new) / 2. Without the a (dt_old - dt_new) / 2 added here, a
+        body in mid-contact when a breakage shrinks dt gains energy (1.9 % measured on impacts
+        of 5.5 mm copper ore at 100 J/kg when dt fell 19-fold). Done for bodies in tracked
+        contacts, the only ones with a large acceleration that yadebreak knows of.
+        """
+        old = O.dt
+        if not new_dt < old:
+            return
+        newton = next((e for e in O.engines if isinstance(e, _wrapper.NewtonIntegrator)), None)
+        gravity = newton.gravity if newton is not None else None
+        half = 0.5 * (old - new_dt)
+        for bid in {k for key in self.contacts for k in key}:
+            b = O.bodies[bid]
+            if b is None or not b.dynamic:
+                continue
+            accel = O.forces.f(bid) / b.state.mass
+            if gravity is not None:
+                accel = accel + gravity
+            b.state.vel = b.state.vel + accel * half
+        O.dt = new_dt
 
     def _zero_pair(self, id_a, id_b, artificial, created):
         """Register an artificial overlap (m) of a new pair; only (1 - local_damping) of it is
@@ -770,9 +814,9 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
         Path(opts.event_log).parent.mkdir(parents=True, exist_ok=True)
         open(opts.event_log, "w").close()
     runner = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run({label!r})",
-                               iterPeriod=opts.read_period, label=label)
+                               iterPeriod=opts.read_period, initRun=True, label=label)
     zero = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run_zero({label!r})",
-                             iterPeriod=1, label=label + "_zero", dead=True)
+                             iterPeriod=1, initRun=True, label=label + "_zero", dead=True)
     engines.insert(loop_idx + 1, runner)
     engines.insert(loop_idx, zero)
     O.engines = engines

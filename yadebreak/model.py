@@ -271,7 +271,31 @@ class SizeDistribution:
         return 100.0 * self.passing_mass / self.total_mass
 
 
-def size_distribution(sizes, resolved=None, dummies=None, unbreakable=None, beta_params=None):
+def dummy_fines_passing(sizes, parent_size, t10_percent, beta_params, fines="gaudin_schuhmann"):
+    """Fraction (0-1) of an event's dummy mass finer than each size (m): the unresolved fines.
+
+    fines="gaudin_schuhmann" (the paper): Eq. 11 below X_MIN of the parent with lambda from
+    Eq. 12. fines="eq10": Eq. 10's own curve below X_MIN, renormalised to 1 at X_MIN, which keeps
+    t10 exact (the paper's extension overstates passing at x = 0.1 by 10-20 % near primary
+    breakage: 2.31 % against 1.94 % for copper ore at t10' = 1.94 %).
+    """
+    sizes = np.atleast_1d(np.asarray(sizes, dtype=float))
+    parent_size = np.atleast_1d(np.asarray(parent_size, dtype=float))
+    t10_percent = np.atleast_1d(np.asarray(t10_percent, dtype=float))
+    if fines == "gaudin_schuhmann":
+        lam = fines_exponent(t10_percent, beta_params)
+        return fines_passing(sizes[None, :], X_MIN * parent_size[:, None], lam[:, None])
+    if fines == "eq10":
+        out = np.empty((len(parent_size), len(sizes)))
+        for k, (d, t) in enumerate(zip(parent_size, t10_percent)):
+            x = np.minimum(sizes / d, X_MIN)
+            out[k] = progeny_passing(t, beta_params, x) / progeny_passing(t, beta_params, X_MIN)
+        return out
+    raise ValueError(f"fines = {fines!r}: accepted 'gaudin_schuhmann' or 'eq10'")
+
+
+def size_distribution(sizes, resolved=None, dummies=None, unbreakable=None, beta_params=None,
+                      fines="gaudin_schuhmann"):
     """Section 7 (Eqs. 11-13): the full product size distribution after a run.
 
     sizes: the sieve sizes (m) at which the cumulative passing mass is wanted.
@@ -282,6 +306,7 @@ def size_distribution(sizes, resolved=None, dummies=None, unbreakable=None, beta
         by Eq. 13 (Eq. 10 at its recorded t10'); a NaN t10' (never stressed to breakage) keeps it
         at its own size.
     beta_params: the material's incomplete-beta parameters (needed for dummies and unbreakable).
+    fines: how dummy masses are spread (see dummy_fines_passing).
     Mass is conserved: passing at a size above every particle equals the total mass.
     """
     sizes = np.atleast_1d(np.asarray(sizes, dtype=float))
@@ -299,9 +324,7 @@ def size_distribution(sizes, resolved=None, dummies=None, unbreakable=None, beta
     if dummies is not None:
         mass, parent, t10_event = (np.atleast_1d(np.asarray(a, dtype=float)) for a in dummies)
         if mass.size:
-            lam = fines_exponent(t10_event, beta_params)
-            frac = fines_passing(sizes[None, :], X_MIN * parent[:, None], lam[:, None])
-            passing += mass @ frac
+            passing += mass @ dummy_fines_passing(sizes, parent, t10_event, beta_params, fines)
             total += float(mass.sum())
     if unbreakable is not None:
         diam, mass, t10_rec = (np.atleast_1d(np.asarray(a, dtype=float)) for a in unbreakable)
