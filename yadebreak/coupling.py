@@ -128,6 +128,7 @@ class Options:
     read_period: int = 1
     family_seed: int = 0
     zero_overlaps: bool = True      # False only to show what the zeroing prevents
+    dummies: str = "spheres"        # "spheres" (the paper) or "ledger" (fines kept outside the DEM)
 
 
 # ------------------------------------------------------------------------------- the controller
@@ -143,9 +144,13 @@ class Breakage:
         self.tracked: dict[int, BodyState] = {}    # breakable + unbreakable awaiting their t10'
         self.open_events: set[int] = set()         # tracked bodies with an open stressing event
         self.contacts: dict[tuple, list] = {}
-        self.zeroed: dict[tuple, float] = {}       # sibling pair -> artificial overlap (m)
+        self.zeroed: dict[tuple, list] = {}        # pair -> [artificial overlap (m), kno0, kso0]
+        self._zero_cache: dict[tuple, tuple] = {}  # pair -> wrappers read every step
+        self.zero_by_body: dict[int, set] = {}     # body -> its zeroed pairs
         self.damped_until: list[tuple] = []        # (time, [ids]) of fresh fragments
         self.events: list[dict] = []
+        self.ledger: list[list] = []              # dummy fines outside the DEM: mass, parent size,
+                                                  # t10', material label, momentum (3)
         self.last_iter = -1
         self.warned: set[str] = set()
         self.top_size = 0.0
@@ -248,6 +253,20 @@ class Breakage:
         self._break_all([(body_id, st, ek, (ek, direction, 1.0))], self.contacts)
         return self.events[-1]
 
+    def finish(self):
+        """Close every open stressing event as if its body had unloaded (damage with the event's
+        largest energy), for runs stopped once the loading is over. Returns how many."""
+        closed = 0
+        for bid in list(self.open_events):
+            st = self.tracked.get(bid)
+            if st is not None and st.event_max > 0.0:
+                touching = [(c, 3 if key[0] == bid else 4) for key, c in self.contacts.items()
+                            if bid in key]
+                self._close_event(bid, st, touching)
+                closed += 1
+        self.open_events.clear()
+        return closed
+
     @property
     def breakage_events(self):
         return [e for e in self.events if e["kind"] == "breakage"]
@@ -274,6 +293,15 @@ class Breakage:
             else:
                 resolved_d.append(2 * st.radius)
                 resolved_m.append(st.mass)
+        if fines:
+            for mass, parent, t10, label, *_ in self.ledger:
+                g = groups.setdefault(label, {"dummy": ([], [], []), "unb": ([], [], [])})
+                for lst, v in zip(g["dummy"], (mass, parent, t10)):
+                    lst.append(v)
+        else:                            # the ledger's fines counted at the dummy size
+            for mass, parent, *_ in self.ledger:
+                resolved_d.append(model.X_MIN * parent)
+                resolved_m.append(mass)
         sizes = np.atleast_1d(np.asarray(sizes, dtype=float))
         passing = np.zeros(sizes.shape)
         total = 0.0
@@ -289,8 +317,10 @@ class Breakage:
         return model.SizeDistribution(sizes, passing, total)
 
     def total_mass(self):
-        """Mass (kg) of every body yadebreak knows, fragments included (the broken excluded)."""
-        return float(sum(st.mass for st in self.bodies.values() if st.kind != "broken"))
+        """Mass (kg) of every body yadebreak knows, fragments and ledger fines included (the
+        broken parents excluded)."""
+        return float(sum(st.mass for st in self.bodies.values() if st.kind != "broken")
+                     + sum(entry[0] for entry in self.ledger))
 
     # -- event log -------------------------------------------------------------------------------
     def _record(self, event):
@@ -319,7 +349,6 @@ class Breakage:
         stiff = self.stiffness_by_id
         seen = {}
         energy = {}               # body -> Ek' (counted)
-        elastic = {}              # body -> stored elastic share of counted contacts
         strongest = {}            # body -> (share energy, normal, sign) of its most energetic contact
         touching = {}             # tracked body -> [(contact record, offset slot)]
         grew = set()
@@ -331,21 +360,25 @@ class Breakage:
             tb = tracked.get(b)
             if ta is None and tb is None:
                 continue
-            g = i.geom
-            if g is None:
-                continue
             key = (a, b)
-            delta = g.penetrationDepth
-            force = i.phys.normalForce.dot(g.normal)
             c = contacts.get(key)
             if c is None:
+                g = i.geom
+                if g is None:
+                    continue
                 ph = i.phys
                 ka = stiff[bodies[a].material.id]
                 kb = stiff[bodies[b].material.id]
-                # [delta, force, En, offset_a, offset_b, kno, e_a, e_b, us, Fs, Es]
+                # [delta, force, En, offset_a, offset_b, kno, e_a, e_b, us, Fs, Es, geom, phys]
+                # (the last two: wrappers kept while the contact lives, never saved)
                 c = [0.0, 0.0, 0.0, 0.0, 0.0, ph.kno,
-                     1.0 / (1.0 + ka / kb), 1.0 / (1.0 + kb / ka), 0.0, 0.0, 0.0]
+                     1.0 / (1.0 + ka / kb), 1.0 / (1.0 + kb / ka), 0.0, 0.0, 0.0, g, ph]
                 contacts[key] = c
+            elif len(c) == 11:                     # restored from O.tags: wrappers again
+                c += [i.geom, i.phys]
+            g = c[11]
+            delta = g.penetrationDepth
+            force = c[12].normalForce.norm()      # compressive while the overlap grows
             if delta > c[0]:
                 c[2] += 0.5 * (c[1] + force) * (delta - c[0])
                 if ta is not None:
@@ -355,7 +388,7 @@ class Breakage:
             c[0] = delta
             c[1] = force
             if cs > 0.0:
-                ph = i.phys
+                ph = c[12]
                 us = ph.usTotal.norm()
                 fs = ph.shearForce.norm()
                 if us > c[8]:
@@ -364,14 +397,12 @@ class Breakage:
                 c[9] = fs
             seen[key] = c
             total = c[2] + cs * c[10]
-            stored = 0.4 * c[5] * max(delta, 0.0) ** 2.5
             if ta is not None:
                 touching.setdefault(a, []).append((c, 3))
                 own = total - c[3]
                 if own >= emin:
                     share = c[6] * own
                     energy[a] = energy.get(a, 0.0) + share
-                    elastic[a] = elastic.get(a, 0.0) + c[6] * stored
                     if share > strongest.get(a, (0.0,))[0]:
                         strongest[a] = (share, g.normal, 1.0)      # normal points a -> b
             if tb is not None:
@@ -380,7 +411,6 @@ class Breakage:
                 if own >= emin:
                     share = c[7] * own
                     energy[b] = energy.get(b, 0.0) + share
-                    elastic[b] = elastic.get(b, 0.0) + c[7] * stored
                     if share > strongest.get(b, (0.0,))[0]:
                         strongest[b] = (share, g.normal, -1.0)
         self.contacts = seen                  # ceased contacts drop out
@@ -408,12 +438,24 @@ class Breakage:
             if ek > st.event_max:
                 st.event_max = ek
                 open_events.add(bid)
-            elif (st.event_max > 0.0 and bid not in grew and elastic.get(bid, 0.0) <= emin):
+            elif (st.event_max > 0.0 and bid not in grew
+                  and self._stored_share(touching.get(bid, ())) <= emin):
                 self._close_event(bid, st, touching.get(bid, ()))
         if broken:
             self._break_all(broken, seen)
         self._release_damping()
         self.last_iter = O.iter
+
+    def _stored_share(self, touching):
+        """Elastic energy (J) a body holds now in its counted contacts: its share of
+        0.4 kno delta^2.5 (Hertz), with kno as the law uses it (scaled for zeroed pairs)."""
+        emin = self.options.emin
+        cs = self.options.cs
+        total = 0.0
+        for c, slot in touching:
+            if c[2] + cs * c[10] - c[slot] >= emin and c[0] > 0.0:
+                total += c[6 if slot == 3 else 7] * 0.4 * c[12].kno * c[0] ** 2.5
+        return total
 
     def _close_event(self, bid, st, touching):
         """End of a stressing event without breakage: Eqs. 5-6 with the event's largest Ek'."""
@@ -489,6 +531,17 @@ class Breakage:
             real = inter.geom.penetrationDepth - (z[0] if z else 0.0)
             neighbours.append((other, max(real, 0.0)))
         O.bodies.erase(bid)
+        for key in list(self.zero_by_body.get(bid, ())):
+            self._drop_zeroed(key)
+        inserted = np.arange(len(radii))
+        if opts.dummies == "ledger":
+            # dummy fines leave the DEM: their mass, momentum and t10' go to the ledger
+            for k in np.nonzero(fam.is_dummy)[0]:
+                self.ledger.append([float(masses[k]), 2.0 * radius, t10, st.material,
+                                    *(float(masses[k]) * vel[k])])
+            inserted = inserted[~fam.is_dummy]
+        radii, centers, masses, vel = radii[inserted], centers[inserted], masses[inserted], vel[inserted]
+        is_dummy = fam.is_dummy[inserted]
         new_bodies = []
         for k in range(len(radii)):
             b = utils.sphere(tuple(centers[k]), float(radii[k]), material=material)
@@ -503,7 +556,7 @@ class Breakage:
         ids = O.bodies.append(new_bodies)
         new_ids = list(ids)
         for k, nid in enumerate(ids):
-            if fam.is_dummy[k]:
+            if is_dummy[k]:
                 kind = "dummy"
             elif model.X_MIN * 2.0 * radii[k] < dmin:
                 kind = "unbreakable"       # its own progeny would be finer than dmin
@@ -529,14 +582,14 @@ class Breakage:
         # everything beyond it is zeroed, while the other children's overlaps with that neighbour
         # are zeroed entirely (else k children would each press with the parent's overlap and
         # multiply the force the parent carried)
-        ii, jj, overlap = placement.overlapping_pairs(centers, radii)
-        if opts.zero_overlaps:
+        if opts.zero_overlaps and len(ids):
+            ii, jj, overlap = placement.overlapping_pairs(centers, radii)
             self._zero_new(ids, centers, radii, ii, jj, overlap, neighbours)
         if self.zeroed:
             self._zero_engine().dead = False
         if opts.global_damping > 0.0:
             self.damped_until.append((O.time + opts.global_damping_time, list(ids)))
-        if opts.time_step_fraction:
+        if opts.time_step_fraction and len(ids):
             tr = placement.rayleigh_time(radii.min(), material.density, material.young,
                                          material.poisson)
             self._pending_dt = min(self._pending_dt, float(opts.time_step_fraction * tr))
@@ -603,44 +656,70 @@ class Breakage:
         key = (min(id_a, id_b), max(id_a, id_b))
         # the zero engine scales kno, kso before the next force evaluation
         self.zeroed[key] = [(1.0 - self.options.local_damping) * artificial, ph.kno, ph.kso]
+        for i in key:
+            self.zero_by_body.setdefault(i, set()).add(key)
 
     def _zero_engine(self):
         return _find_engine(self.label + "_zero")
 
     def zero_overlaps(self):
-        """Before the InteractionLoop: kno, kso of zeroed sibling pairs scaled so that the Hertz
-        force is that of the overlap beyond the artificial one; the reference shrinks as the pair
-        opens and is dropped when it separates."""
+        """Before the InteractionLoop: kno, kso of zeroed pairs scaled so that the Hertz force is
+        that of the overlap beyond the artificial one; the reference shrinks as the pair opens
+        and is dropped when it separates. Sphere pairs use this step's positions (no lag)."""
         if not self.zeroed:
             self._zero_engine().dead = True
             return
-        bodies = O.bodies
+        cache = self._zero_cache
         done = []
         for key, z in self.zeroed.items():
-            ba = bodies[key[0]]
-            bb = bodies[key[1]]
-            if ba is None or bb is None or not O.interactions.has(key[0], key[1]):
-                done.append(key)
-                continue
-            inter = O.interactions[key[0], key[1]]
-            if not inter.isReal:
-                done.append(key)
-                continue
-            if isinstance(ba.shape, _wrapper.Sphere) and isinstance(bb.shape, _wrapper.Sphere):
-                d = ba.shape.radius + bb.shape.radius - (ba.state.pos - bb.state.pos).norm()
+            c = cache.get(key)
+            if c is None:
+                c = self._zero_wrappers(key)
+                if c is None:
+                    done.append(key)
+                    continue
+            state_a, state_b, radius_sum, phys, geom = c
+            if geom is None:
+                d = radius_sum - (state_a.pos - state_b.pos).norm()
             else:
-                d = inter.geom.penetrationDepth     # walls, facets: the last step's overlap
+                d = geom.penetrationDepth          # walls, facets: the last step's overlap
             if d <= 0.0:
                 done.append(key)
                 continue
-            if d < z[0]:
+            if d <= z[0]:
                 z[0] = d
+                if z[1] != 0.0 and phys.kno != 0.0:
+                    phys.kno = 0.0
+                    phys.kso = 0.0
+                continue
             ratio = (d - z[0]) / d
-            ph = inter.phys
-            ph.kno = z[1] * ratio ** 1.5
-            ph.kso = z[2] * ratio ** 0.5
+            phys.kno = z[1] * ratio ** 1.5
+            phys.kso = z[2] * ratio ** 0.5
         for key in done:
-            del self.zeroed[key]
+            self._drop_zeroed(key)
+
+    def _zero_wrappers(self, key):
+        ba, bb = O.bodies[key[0]], O.bodies[key[1]]
+        if ba is None or bb is None or not O.interactions.has(key[0], key[1]):
+            return None
+        inter = O.interactions[key[0], key[1]]
+        if not inter.isReal:
+            return None
+        spheres = isinstance(ba.shape, _wrapper.Sphere) and isinstance(bb.shape, _wrapper.Sphere)
+        c = (ba.state, bb.state, (ba.shape.radius + bb.shape.radius) if spheres else 0.0,
+             inter.phys, None if spheres else inter.geom)
+        self._zero_cache[key] = c
+        return c
+
+    def _drop_zeroed(self, key):
+        self.zeroed.pop(key, None)
+        self._zero_cache.pop(key, None)
+        for i in key:
+            pairs = self.zero_by_body.get(i)
+            if pairs is not None:
+                pairs.discard(key)
+                if not pairs:
+                    del self.zero_by_body[i]
 
     def _release_damping(self):
         if not self.damped_until:
@@ -665,9 +744,9 @@ class Breakage:
                 "rng": self.rng.bit_generator.state, "iter": O.iter, "top_size": self.top_size,
                 "bodies": {str(k): v.as_dict() for k, v in self.bodies.items()},
                 "tracked": sorted(self.tracked),
-                "contacts": [[k[0], k[1], c] for k, c in self.contacts.items()],
+                "contacts": [[k[0], k[1], c[:11]] for k, c in self.contacts.items()],
                 "zeroed": [[k[0], k[1], z] for k, z in self.zeroed.items()],
-                "damped_until": self.damped_until, "events": self.events,
+                "damped_until": self.damped_until, "events": self.events, "ledger": self.ledger,
                 "warned": sorted(self.warned)}
 
     def sync_tags(self):
@@ -684,9 +763,13 @@ class Breakage:
         self.tracked = {i: self.bodies[i] for i in data["tracked"]}
         self.open_events = {i for i in data["tracked"] if self.bodies[i].event_max > 0.0}
         self.contacts = {(a, b): c for a, b, c in data["contacts"]}
-        self.zeroed = {(a, b): z for a, b, z in data["zeroed"]}
+        for a, b, z in data["zeroed"]:
+            self.zeroed[(a, b)] = z
+            self.zero_by_body.setdefault(a, set()).add((a, b))
+            self.zero_by_body.setdefault(b, set()).add((a, b))
         self.damped_until = [tuple(x) for x in data["damped_until"]]
         self.events = data["events"]
+        self.ledger = data["ledger"]
         self.warned = set(data["warned"])
         self.last_iter = data["iter"] - 1
         for bid, st in self.bodies.items():
@@ -846,6 +929,8 @@ def _check_options(opts):
         problems.append(f"global_damping_time = {opts.global_damping_time} s: accepted >= 0")
     if opts.time_step_fraction is not None and not (0.0 < opts.time_step_fraction <= 1.0):
         problems.append(f"time_step_fraction = {opts.time_step_fraction}: accepted (0, 1]")
+    if opts.dummies not in ("spheres", "ledger"):
+        problems.append(f"dummies = {opts.dummies!r}: accepted 'spheres' or 'ledger'")
     if not (isinstance(opts.read_period, int) and opts.read_period >= 1):
         problems.append(f"read_period = {opts.read_period}: accepted an integer >= 1")
     if problems:

@@ -66,3 +66,89 @@ def _left(i):
     if b is None:
         return True                # broken and replaced: its fragments fly on
     return b.state.vel[2] >= 0.0 and len(O.interactions.withBody(i)) == 0
+
+
+BALL_DIAMETER = 0.088          # m, the paper's steel ball
+BALL_MASS = 2.78               # kg
+
+
+def hex_bed_positions(size, rings, layers=1, gap=0.01):
+    """Centres of a hexagonal bed: a central particle and `rings` rings per layer (1 + 3k(k+1)
+    particles), layers stacked in the hollows (ABAB), the bottom layer touching z = 0."""
+    spacing = size * (1.0 + gap)
+    radius = size / 2.0
+    base = []
+    for q in range(-rings, rings + 1):
+        for r in range(-rings, rings + 1):
+            if max(abs(q), abs(r), abs(q + r)) <= rings:
+                base.append((spacing * (q + r / 2.0), spacing * r * math.sqrt(3.0) / 2.0))
+    base = np.array(base)
+    reach = np.max(np.linalg.norm(base, axis=1)) + 1e-9
+    offset = np.array([spacing / 2.0, spacing * math.sqrt(3.0) / 6.0])
+    out = []
+    for layer in range(layers):
+        xy = base + (offset if layer % 2 else 0.0)
+        if layer % 2:
+            xy = xy[np.linalg.norm(xy, axis=1) <= reach]
+        z = radius + layer * spacing * math.sqrt(2.0 / 3.0)
+        out += [(x, y, z) for x, y in xy]
+    return np.array(out)
+
+
+def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, energy=3.05,
+                     seed=1, settle_steps=3000, **options):
+    """The paper's unconfined bed impact: a 88 mm steel ball on a bed resting on a steel anvil.
+
+    The ball starts just above the bed with the speed of its drop, v = sqrt(2 E / m). Beds of
+    several layers are held by a cylindrical steel holder, removed when the ball first touches a
+    particle (hold_release() does that). Returns (controller, info dict).
+    """
+    O.reset()
+    ip2, mats = add_materials({"ore": material, "steel": "steel"},
+                              stiffness_scale=options.pop("stiffness_scale", 1.0))
+    anvil = O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="steel"))
+    centers = hex_bed_positions(size, rings, layers)
+    particles = [O.bodies.append(utils.sphere(tuple(c), size / 2.0, material="ore"))
+                 for c in centers]
+    holder = []
+    if layers > 1:
+        reach = np.max(np.linalg.norm(centers[:, :2], axis=1)) + size / 2.0 + 0.02 * size
+        height = centers[:, 2].max() + size
+        holder = O.bodies.append(utils.facetCylinder((0, 0, height / 2.0), reach, height,
+                                                     segmentsNumber=24, wallMask=4,
+                                                     material="steel"))
+    O.engines = hertz_engines(ip2, gravity=(0.0, 0.0, -9.81), facets=bool(holder))
+    if layers > 1 and settle_steps:           # settle the stack before anything is tracked
+        O.dt = 0.2 * utils.PWaveTimeStep()
+        newton = O.engines[-1]
+        newton.damping = 0.4
+        O.run(settle_steps, True)
+        newton.damping = 0.0
+        for i in particles:
+            O.bodies[i].state.vel = (0, 0, 0)
+            O.bodies[i].state.angVel = (0, 0, 0)
+    top = max(O.bodies[i].state.pos[2] for i in particles) + size / 2.0
+    ball_radius = BALL_DIAMETER / 2.0
+    ball = utils.sphere((0.0, 0.0, top + ball_radius + 0.02 * size), ball_radius, material="steel")
+    ball.state.mass = BALL_MASS
+    inertia = 0.4 * BALL_MASS * ball_radius ** 2
+    ball.state.inertia = (inertia, inertia, inertia)
+    speed = math.sqrt(2.0 * energy / BALL_MASS)
+    ball.state.vel = (0.0, 0.0, -speed)
+    ball_id = O.bodies.append(ball)
+    brk = attach({"ore": material}, seed=seed, **options)
+    info = {"anvil": anvil, "particles": particles, "holder": list(holder), "ball": ball_id,
+            "speed": speed, "centers": centers, "material": mats["ore"]}
+    return brk, info
+
+
+def hold_release(info):
+    """Erase the holder once the ball touches a particle; True once released (or none)."""
+    if not info["holder"]:
+        return True
+    if any(O.interactions.withBody(info["ball"])):
+        for i in info["holder"]:
+            O.bodies.erase(i)
+        info["holder"] = []
+        return True
+    return False

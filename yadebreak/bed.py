@@ -1,0 +1,171 @@
+"""The bed-impact job behind scripts/bed_impact.py (coupling layer: runs YADE, writes outputs)."""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import scenes
+from .coupling import O
+from .scriptargs import progress
+
+FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
+TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
+
+
+def _fates(brk, particles):
+    """'broken', 'damaged' or 'intact' for each original particle."""
+    kinds = {}
+    for e in brk.events:
+        if e["kind"] == "breakage":
+            kinds[e["id"]] = "broken"
+        elif e["kind"] == "damage":
+            kinds.setdefault(e["id"], "damaged")
+    return [kinds.get(i, "intact") for i in particles]
+
+
+def capture_radius(brk, info):
+    """Largest horizontal distance (m) from the ball's axis to the centre of an original particle
+    that was stressed by the impact (a damage or breakage event: Ek' reached emin). The paper's
+    carbon paper under the bed records the impressions of the particles pressed onto the anvil,
+    which lie under their centres."""
+    fates = _fates(brk, info["particles"])
+    radii = [math.hypot(c[0], c[1]) for c, f in zip(info["centers"], fates) if f != "intact"]
+    return max(radii) if radii else 0.0
+
+
+def write_vtk(path, brk):
+    """Legacy VTK polydata of every sphere: radius, fracture energy, damage, class."""
+    from .coupling import _wrapper
+    classes = {"breakable": 0, "unbreakable": 1, "dummy": 2}
+    rows = []
+    for b in O.bodies:
+        if b is None or not isinstance(b.shape, _wrapper.Sphere):
+            continue
+        st = brk.bodies.get(b.id)
+        fe = st.fracture_energy if st is not None and math.isfinite(st.fracture_energy) else -1.0
+        rows.append((*b.state.pos, b.shape.radius, fe, st.damage if st else 0.0,
+                     classes.get(st.kind, 3) if st else 3))
+    with open(path, "w") as f:
+        f.write("# vtk DataFile Version 3.0\nyadebreak spheres\nASCII\nDATASET POLYDATA\n")
+        f.write(f"POINTS {len(rows)} double\n")
+        f.writelines(f"{r[0]:.9g} {r[1]:.9g} {r[2]:.9g}\n" for r in rows)
+        f.write(f"POINT_DATA {len(rows)}\n")
+        for k, name in ((3, "radius"), (4, "fracture_energy"), (5, "damage")):
+            f.write(f"SCALARS {name} double 1\nLOOKUP_TABLE default\n")
+            f.writelines(f"{r[k]:.9g}\n" for r in rows)
+        f.write("SCALARS class int 1\nLOOKUP_TABLE default\n")
+        f.writelines(f"{r[6]}\n" for r in rows)
+
+
+def run(args, quiet=False):
+    """Build, run and report one bed impact. Returns (controller, summary dict)."""
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    energy = args.energy if args.speed <= 0 else 0.5 * scenes.BALL_MASS * args.speed ** 2
+    options = dict(time_step_fraction=args.time_step_fraction, dummies=args.dummies,
+                   event_log=str(out / "events.jsonl"))
+    if args.dmin > 0:
+        options["dmin"] = args.dmin
+    if args.global_damping > 0:
+        options.update(global_damping=args.global_damping, global_damping_time=5e-4)
+    start = time.time()
+    brk, info = scenes.bed_impact_scene(args.material, args.size, args.rings, args.layers,
+                                        energy, args.seed, **options)
+    say = (lambda m: None) if quiet else progress
+    say(f"{len(info['particles'])} particles of {args.material} ({1e3 * args.size:g} mm), "
+        f"{args.layers} layer(s); ball at {info['speed']:.3f} m/s ({energy:g} J); dt {O.dt:.3g} s")
+    initial_mass = brk.total_mass()
+    ball = O.bodies[info["ball"]]
+    v0 = info["speed"]
+    touched = turned = None
+    last_report = start
+    while True:
+        O.run(100 if touched is None else 400, True)
+        if touched is None and any(O.interactions.withBody(info["ball"])):
+            touched = O.time
+            scenes.hold_release(info)
+        vz = ball.state.vel[2]
+        if touched is not None and turned is None and vz >= 0.0:
+            turned = O.time                    # deepest penetration: loading is over
+        # breakage happens while loading: after the turn, a short unloading, then open events
+        # are closed with their largest energy (brk.finish)
+        if turned is not None and O.time >= turned + TAIL:
+            break
+        if O.time > args.max_time:
+            say(f"stopped at max_time = {args.max_time} s of simulated time")
+            break
+        now = time.time()
+        if now - last_report > 5.0:
+            done = 0.0 if touched is None else (0.5 * (1 - max(-vz, 0.0) / v0) if turned is None
+                                                else 0.5 + 0.5 * (O.time - turned) / TAIL)
+            eta = (now - start) * (1 - done) / done if done > 0.05 else float("nan")
+            say(f"t = {1e3 * O.time:.3f} ms, {len(brk.breakage_events)} breakages, "
+                f"{sum(1 for b in O.bodies if b is not None)} bodies, ball {vz:+.3f} m/s, "
+                f"wall {now - start:.0f} s, about {eta:.0f} s left")
+            last_report = now
+    brk.finish()
+    runtime = time.time() - start
+
+    sieves = np.geomspace(1e-5, 2 * args.size, 80)
+    sd = brk.size_distribution(sieves)
+    broken_mass = float(brk.size_distribution([FEED_LOWER_SIEVE]).passing_mass[0])
+    fates = _fates(brk, info["particles"])
+    summary = {
+        "material": args.material, "size": args.size, "rings": args.rings, "layers": args.layers,
+        "energy": energy, "ball_speed": v0, "seed": args.seed, "particles": len(info["particles"]),
+        "initial_mass": initial_mass, "final_mass": brk.total_mass(),
+        "mass_relative_error": abs(brk.total_mass() - initial_mass) / initial_mass,
+        "broken_mass": broken_mass, "broken_mass_fraction": broken_mass / initial_mass,
+        "capture_radius": capture_radius(brk, info),
+        "breakage_events": len(brk.breakage_events),
+        "damage_events": sum(1 for e in brk.events if e["kind"] == "damage"),
+        "particles_broken": fates.count("broken"), "particles_damaged": fates.count("damaged"),
+        "simulated_time": O.time, "steps": O.iter, "final_dt": O.dt, "runtime_s": runtime,
+        "wall_time_read_s": brk.wall_time["read"], "wall_time_replace_s": brk.wall_time["replace"],
+    }
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    with open(out / "size_distribution.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["size_m", "passing_percent"])
+        w.writerows(zip(sd.sizes, sd.passing_percent))
+    write_vtk(out / "bodies.vtk", brk)
+    _plots(out, sd, info, fates, summary)
+    say(f"done in {runtime:.1f} s: {summary['breakage_events']} breakages, broken mass "
+        f"{1e3 * broken_mass:.3f} g ({100 * summary['broken_mass_fraction']:.1f} %), capture "
+        f"radius {1e3 * summary['capture_radius']:.1f} mm; outputs in {out}")
+    return brk, summary
+
+
+def _plots(out, sd, info, fates, summary):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.semilogx(1e3 * sd.sizes, sd.passing_percent, "o-", ms=3)
+    ax.axvline(1e3 * FEED_LOWER_SIEVE, ls=":", c="k", label="4.75 mm (broken mass)")
+    ax.set(xlabel="size (mm)", ylabel="cumulative passing (%)",
+           title=f"{summary['material']}, {summary['rings']} rings x {summary['layers']} layer(s), "
+                 f"{summary['energy']:g} J")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out / "size_distribution.png", dpi=110)
+    plt.close(fig)
+    colours = {"intact": "0.8", "damaged": "tab:orange", "broken": "tab:red"}
+    fig, ax = plt.subplots(figsize=(5.5, 5.5))
+    r = summary["size"] / 2.0
+    for c, f in sorted(zip(info["centers"], fates), key=lambda cf: cf[0][2]):
+        ax.add_patch(Circle((1e3 * c[0], 1e3 * c[1]), 1e3 * r, fc=colours[f], ec="k", lw=0.5))
+    reach = 1e3 * (np.max(np.abs(info["centers"][:, :2])) + 2 * r)
+    ax.add_patch(Circle((0, 0), 1e3 * summary["capture_radius"], fill=False, ls="--", ec="b"))
+    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), aspect="equal", xlabel="x (mm)",
+           ylabel="y (mm)", title="top view: grey intact, orange damaged, red broken;\n"
+                                  "dashed: capture radius")
+    fig.tight_layout()
+    fig.savefig(out / "bed_top_view.png", dpi=110)
+    plt.close(fig)
