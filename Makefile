@@ -5,7 +5,7 @@
 PY := /usr/bin/python3
 OUT ?= out
 
-.PHONY: deps demo test test-model bench
+.PHONY: deps demo model-demo test test-model bench
 
 # apt-get only when something is missing, so repeated runs start at once.
 deps:
@@ -16,7 +16,11 @@ deps:
 	fi
 
 demo: deps
-	$(PY) -m yadebreak demo --out $(OUT)/demo
+	yade -n -x scripts/bed_impact.py --out $(OUT)/bed_impact
+
+# The model alone (no YADE): breakage probability, t10 and progeny curves of a material.
+model-demo:
+	$(PY) -m yadebreak demo --out $(OUT)/model_demo
 
 test: deps
 	$(PY) -m pytest -q tests

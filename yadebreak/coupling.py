@@ -20,6 +20,7 @@ produces Hertz-Mindlin force (see ../shared/YADE.md).
 """
 from __future__ import annotations
 
+import heapq
 import json
 import math
 import os
@@ -125,7 +126,9 @@ class Options:
     time_step_fraction: float | None = 0.05
     event_log: str | None = None
     seed: int = 0
-    read_period: int = 1
+    read_period: int | str = 1      # 1: every step (exact); k; or "auto" (see _auto_period)
+    read_fraction: float = 0.05     # "auto": read at this fraction of the Rayleigh time of the
+                                    # smallest breakable body
     family_seed: int = 0
     zero_overlaps: bool = True      # False only to show what the zeroing prevents
     dummies: str = "spheres"        # "spheres" (the paper) or "ledger" (fines kept outside the DEM)
@@ -157,6 +160,8 @@ class Breakage:
         self.wall_time = {"read": 0.0, "replace": 0.0}
         self._resolve_materials()
         self._log = None
+        self._breakable_radii = []                 # heap of (radius, id), lazily cleaned
+        self.period = 1 if options.read_period == "auto" else options.read_period
 
     # -- set-up -------------------------------------------------------------------------------
     def _resolve_materials(self):
@@ -236,6 +241,8 @@ class Breakage:
         self.bodies[body.id] = st
         if st.kind in ("breakable", "unbreakable"):
             self.tracked[body.id] = st
+        if st.kind == "breakable":
+            heapq.heappush(self._breakable_radii, (st.radius, body.id))
         body.breakage = st                      # readable on the body while the scene lives
 
     # -- public API ------------------------------------------------------------------------------
@@ -429,8 +436,9 @@ class Breakage:
                 if specific - st.specific_energy > 0.8 * st.fracture_energy and st.specific_energy > 0:
                     self._warn_once("jump", (
                         f"specific energy rose by {100 * (specific - st.specific_energy) / st.fracture_energy:.0f} % "
-                        f"of the fracture energy in one step at body {bid}: reduce the time step "
-                        f"(time_step_fraction) for an accurate t10'"))
+                        f"of the fracture energy between two reads at body {bid} (read every "
+                        f"{self.period} step(s) of {O.dt:.3g} s): reduce time_step_fraction (or "
+                        f"read_fraction / read_period) for an accurate t10'"))
                 st.specific_energy = specific
                 broken.append((bid, st, ek, strongest.get(bid)))
                 continue
@@ -445,6 +453,23 @@ class Breakage:
             self._break_all(broken, seen)
         self._release_damping()
         self.last_iter = O.iter
+        if self.options.read_period == "auto":
+            self._auto_period()
+
+    def _auto_period(self):
+        """Read every k steps, k dt <= read_fraction T_R of the smallest breakable body."""
+        heap = self._breakable_radii
+        while heap and getattr(self.tracked.get(heap[0][1]), "kind", None) != "breakable":
+            heapq.heappop(heap)                  # broken since: drop lazily
+        k = 1
+        if heap:
+            radius, bid = heap[0]
+            mat = O.bodies[bid].material
+            tr = float(placement.rayleigh_time(radius, mat.density, mat.young, mat.poisson))
+            k = max(1, int(self.options.read_fraction * tr / O.dt))
+        if k != self.period:
+            self.period = k
+            _find_engine(self.label).iterPeriod = k
 
     def _stored_share(self, touching):
         """Elastic energy (J) a body holds now in its counted contacts: its share of
@@ -761,6 +786,12 @@ class Breakage:
         self.top_size = data["top_size"]
         self.bodies = {int(k): BodyState(**v) for k, v in data["bodies"].items()}
         self.tracked = {i: self.bodies[i] for i in data["tracked"]}
+        self._breakable_radii = [(st.radius, i) for i, st in self.tracked.items()
+                                 if st.kind == "breakable"]
+        heapq.heapify(self._breakable_radii)
+        engine = _find_engine(label)
+        if engine is not None:
+            self.period = engine.iterPeriod
         self.open_events = {i for i in data["tracked"] if self.bodies[i].event_max > 0.0}
         self.contacts = {(a, b): c for a, b, c in data["contacts"]}
         for a, b, z in data["zeroed"]:
@@ -798,7 +829,7 @@ def _find_engine(label):
 
 def _controller(label):
     ctl = _REGISTRY.get(label)
-    stale = ctl is None or O.iter <= ctl.last_iter or O.iter > ctl.last_iter + ctl.options.read_period
+    stale = ctl is None or O.iter <= ctl.last_iter or O.iter > ctl.last_iter + ctl.period
     if stale and ctl is not None and ctl.last_iter < 0:
         stale = False
     if stale:
@@ -851,7 +882,10 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     Options: cs (0), emin (1e-4 J), kappa, emax_ratio (override the files), replace (True),
     dmin (top size / 20), local_damping (0), global_damping (0), global_damping_time (0 s),
     time_step_fraction (0.05 of the smallest sphere's Rayleigh time; None leaves O.dt),
-    event_log (a JSON-lines path), read_period (1: contacts read every step).
+    event_log (a JSON-lines path), read_period (1: contacts read every step; an integer k; or
+    "auto": every k steps with k dt <= read_fraction (0.05) of the Rayleigh time of the smallest
+    breakable body, so contacts of bodies that can break are sampled as finely as the paper's
+    5 % time step while dt follows the finest fragment).
     """
     unknown = set(options) - set(Options.__dataclass_fields__) - {"seed"}
     if unknown:
@@ -897,7 +931,8 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
         Path(opts.event_log).parent.mkdir(parents=True, exist_ok=True)
         open(opts.event_log, "w").close()
     runner = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run({label!r})",
-                               iterPeriod=opts.read_period, initRun=True, label=label)
+                               iterPeriod=1 if opts.read_period == "auto" else opts.read_period,
+                               initRun=True, label=label)
     zero = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run_zero({label!r})",
                              iterPeriod=1, initRun=True, label=label + "_zero", dead=True)
     engines.insert(loop_idx + 1, runner)
@@ -931,7 +966,11 @@ def _check_options(opts):
         problems.append(f"time_step_fraction = {opts.time_step_fraction}: accepted (0, 1]")
     if opts.dummies not in ("spheres", "ledger"):
         problems.append(f"dummies = {opts.dummies!r}: accepted 'spheres' or 'ledger'")
-    if not (isinstance(opts.read_period, int) and opts.read_period >= 1):
-        problems.append(f"read_period = {opts.read_period}: accepted an integer >= 1")
+    if not (opts.read_period == "auto" or (isinstance(opts.read_period, int)
+                                           and not isinstance(opts.read_period, bool)
+                                           and opts.read_period >= 1)):
+        problems.append(f"read_period = {opts.read_period!r}: accepted an integer >= 1 or 'auto'")
+    if not (0.0 < opts.read_fraction <= 1.0):
+        problems.append(f"read_fraction = {opts.read_fraction}: accepted (0, 1]")
     if problems:
         raise AttachError("bad option(s): " + "; ".join(problems))

@@ -338,3 +338,25 @@ def size_distribution(sizes, resolved=None, dummies=None, unbreakable=None, beta
                 passing += m * progeny_passing(t, beta_params, sizes / d) / 100.0
             total += float(mass.sum())
     return SizeDistribution(sizes=sizes, passing_mass=passing, total_mass=total)
+
+
+def repeated_impact_broken_fraction(absorbed_energy, e50, sigma, emax_ratio, gamma, impacts,
+                                    quantiles=20000):
+    """Fraction broken after each of `impacts` identical impacts (paper Fig. 11's model twin).
+
+    absorbed_energy: Ek'/mp of every impact (J/kg). Each particle's fracture energy (Eqs. 1-2,
+    taken at evenly spaced quantiles, a deterministic quadrature) is weakened after every impact
+    it survives (Eqs. 5-6); it breaks at the first impact whose energy exceeds it.
+    Returns an array of length `impacts`.
+    """
+    u = (np.arange(quantiles) + 0.5) / quantiles
+    energy = fracture_energy_ppf(u, e50, sigma, emax_ratio)
+    broken = np.zeros(quantiles, dtype=bool)
+    out = np.empty(impacts)
+    for k in range(impacts):
+        now = ~broken & (absorbed_energy > energy)
+        broken |= now
+        alive = ~broken
+        energy[alive] = weakened_fracture_energy(energy[alive], absorbed_energy / energy[alive], gamma)
+        out[k] = broken.mean()
+    return out
