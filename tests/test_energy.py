@@ -136,3 +136,35 @@ def test_single_impact_broken_fraction_within_3_binomial_sigma(scene, material, 
     sigma = math.sqrt(p * (1 - p) / n)
     assert 0.05 < p < 0.95
     assert abs(fraction - p) <= 3 * sigma
+
+
+def test_repeated_impacts_follow_the_damage_model(scene):
+    """Paper Fig. 11: the broken fraction after each impact against the model's twin (Eqs. 1-6),
+    within 3 binomial sigma at every impact (200 particles, fixed seed)."""
+    from yade import O
+    from yadebreak import scenes
+    mat = load_material("copper_ore")
+    n, impacts, energy, size = 200, 6, 94.7, 37.5e-3
+    speed = math.sqrt(2 * energy)
+    brk, ids = scenes.impact_scene(mat, size, [speed] * n, seed=21, replace=False)
+    home = {i: tuple(O.bodies[i].state.pos) for i in ids}
+    alive = list(ids)
+    got = []
+    for _ in range(impacts):
+        for i in alive:
+            O.bodies[i].state.pos = home[i]
+            O.bodies[i].state.vel = (0, 0, -speed)
+            O.bodies[i].state.angVel = (0, 0, 0)
+        scenes.run_until_rebound(alive)
+        broken = {e["id"] for e in brk.breakage_events}
+        for i in [i for i in alive if i in broken]:
+            O.bodies.erase(i)
+        alive = [i for i in alive if i not in broken]
+        got.append(1 - len(alive) / n)
+    share = mat.energy_partition(load_material("steel"))
+    expected = model.repeated_impact_broken_fraction(
+        share * energy, float(mat.median_fracture_energy(size)), mat.sigma, mat.emax_ratio,
+        mat.gamma, impacts)
+    sigma = np.sqrt(expected * (1 - expected) / n)
+    assert np.all(np.abs(np.array(got) - expected) <= 3 * sigma)
+    assert got[-1] > 2 * got[0]             # damage matters: later impacts break more

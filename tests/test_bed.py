@@ -1,0 +1,60 @@
+"""The main job (issue 6): a small bed runs headless, writes every output, conserves mass (YADE)."""
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.yade
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _args(out, energy, seed=3, rings=1):
+    return argparse.Namespace(material="copper_ore", size=5.5e-3, rings=rings, layers=1,
+                              energy=energy, speed=0.0, seed=seed, time_step_fraction=0.05,
+                              dmin=0.0, global_damping=0.0, dummies="ledger", read_period="auto",
+                              max_time=0.02, out=str(out))
+
+
+def test_small_bed_writes_every_output_and_conserves_mass(scene, tmp_path):
+    from yadebreak import bed
+    brk, summary = bed.run(_args(tmp_path, 0.6), quiet=True)
+    for name in ("summary.json", "events.jsonl", "size_distribution.csv", "size_distribution.png",
+                 "bed_top_view.png", "bodies.vtk"):
+        assert (tmp_path / name).stat().st_size > 0, name
+    saved = json.loads((tmp_path / "summary.json").read_text())
+    for key in ("broken_mass", "broken_mass_fraction", "capture_radius", "breakage_events",
+                "initial_mass", "final_mass", "runtime_s"):
+        assert key in saved
+    assert saved["final_mass"] == pytest.approx(saved["initial_mass"], rel=1e-9)
+    assert saved["particles"] == 7
+    assert 0.0 <= saved["broken_mass_fraction"] <= 1.0
+    lines = (tmp_path / "events.jsonl").read_text().splitlines()
+    assert len(lines) == len(brk.events)
+
+
+def test_higher_energy_breaks_more_mass(scene, tmp_path):
+    from yadebreak import bed, coupling
+    from yade import O
+    masses = []
+    for energy in (0.3, 0.9):
+        coupling._REGISTRY.clear()
+        O.reset()
+        _, summary = bed.run(_args(tmp_path / f"e{energy}", energy, seed=5), quiet=True)
+        masses.append(summary["broken_mass"])
+    assert masses[1] > masses[0]
+
+
+def test_bed_script_runs_headless(tmp_path):
+    """The script itself, as users run it: yade -n -x scripts/bed_impact.py ..."""
+    out = tmp_path / "bed"
+    proc = subprocess.run(["yade", "-n", "-x", str(ROOT / "scripts" / "bed_impact.py"),
+                           "--rings", "1", "--energy", "0.5", "--out", str(out)],
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["final_mass"] == pytest.approx(summary["initial_mass"], rel=1e-9)
+    assert "[yadebreak] done in" in proc.stdout
