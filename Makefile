@@ -9,9 +9,10 @@ OUT ?= out
 
 # apt-get only when something is missing, so repeated runs start at once.
 deps:
-	@if ! command -v yade >/dev/null 2>&1 || ! $(PY) -c "import pytest, numpy, scipy, matplotlib, yade" >/dev/null 2>&1; then \
+	@if ! command -v yade >/dev/null 2>&1 || ! $(PY) -c "import pytest, numpy, scipy, matplotlib; \
+		from yadebreak.yadepath import ensure_yade_importable as ok; assert ok()" >/dev/null 2>&1; then \
 		echo "[yadebreak] installing YADE and Python packages from Debian (a few minutes, once)"; \
-		apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends \
+		apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q \
 			yade python3-yade python3-pytest python3-numpy python3-scipy python3-matplotlib; \
 	fi
 
