@@ -32,3 +32,4 @@ test-model:
 
 bench: deps
 	$(PY) benchmarks/bench_families.py
+	$(PY) benchmarks/bench_engine.py

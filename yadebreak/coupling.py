@@ -161,6 +161,7 @@ class Breakage:
         self._resolve_materials()
         self._log = None
         self._breakable_radii = []                 # heap of (radius, id), lazily cleaned
+        self._auto_key = None
         self.period = 1 if options.read_period == "auto" else options.read_period
 
     # -- set-up -------------------------------------------------------------------------------
@@ -461,6 +462,10 @@ class Breakage:
         heap = self._breakable_radii
         while heap and getattr(self.tracked.get(heap[0][1]), "kind", None) != "breakable":
             heapq.heappop(heap)                  # broken since: drop lazily
+        top = (heap[0] if heap else None, O.dt)
+        if top == self._auto_key:              # nothing changed: keep k (no numpy per step)
+            return
+        self._auto_key = top
         k = 1
         if heap:
             radius, bid = heap[0]

@@ -74,7 +74,8 @@ BALL_MASS = 2.78               # kg
 
 def hex_bed_positions(size, rings, layers=1, gap=0.01):
     """Centres of a hexagonal bed: a central particle and `rings` rings per layer (1 + 3k(k+1)
-    particles), layers stacked in the hollows (ABAB), the bottom layer touching z = 0."""
+    particles), layers stacked in the hollows (ABAB), each touching the three below it, the
+    bottom layer touching z = 0."""
     spacing = size * (1.0 + gap)
     radius = size / 2.0
     base = []
@@ -90,7 +91,7 @@ def hex_bed_positions(size, rings, layers=1, gap=0.01):
         xy = base + (offset if layer % 2 else 0.0)
         if layer % 2:
             xy = xy[np.linalg.norm(xy, axis=1) <= reach]
-        z = radius + layer * spacing * math.sqrt(2.0 / 3.0)
+        z = radius + layer * math.sqrt(size ** 2 - spacing ** 2 / 3.0)
         out += [(x, y, z) for x, y in xy]
     return np.array(out)
 
@@ -114,9 +115,10 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
     if layers > 1:
         reach = np.max(np.linalg.norm(centers[:, :2], axis=1)) + size / 2.0 + 0.02 * size
         height = centers[:, 2].max() + size
-        holder = O.bodies.append(utils.facetCylinder((0, 0, height / 2.0), reach, height,
-                                                     segmentsNumber=24, wallMask=4,
-                                                     material="steel"))
+        from yade import geom    # utils.facetCylinder is broken in YADE 2023.02a
+        holder = O.bodies.append(geom.facetCylinder((0, 0, height / 2.0), reach, height,
+                                                    segmentsNumber=24, wallMask=4,
+                                                    material="steel"))
     O.engines = hertz_engines(ip2, gravity=(0.0, 0.0, -9.81), facets=bool(holder))
     if layers > 1 and settle_steps:           # settle the stack before anything is tracked
         O.dt = 0.2 * utils.PWaveTimeStep()

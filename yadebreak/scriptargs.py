@@ -2,7 +2,7 @@
 
     args = script_params(dict(material="copper_ore", size=5.5e-3, out="out/x"), __doc__)
 
-Under yade-batch (PARAM_TABLE set), yade.utils.readParamsFromTable supplies the values; otherwise
+Under yade-batch (YADE_BATCH set), yade.utils.readParamsFromTable supplies the values; otherwise
 argparse reads sys.argv. Types follow the defaults. Never imports yade unless yade-batch runs it.
 """
 import argparse
@@ -11,11 +11,16 @@ import sys
 
 
 def script_params(defaults, description=None, argv=None):
-    if "PARAM_TABLE" in os.environ:
-        from yade import utils
-        from yade.params import table
+    if os.environ.get("YADE_BATCH"):
+        from yade import O, utils
         utils.readParamsFromTable(noTableOk=True, **defaults)
-        return argparse.Namespace(**{k: getattr(table, k) for k in defaults})
+        from yade.params import table      # exists once the row has been read
+        values = {k: getattr(table, k) for k in defaults}
+        description = O.tags["description"] if "description" in O.tags.keys() else None
+        if "out" in defaults and values["out"] == defaults["out"] and description:
+            values["out"] = str(os.path.join(os.path.dirname(defaults["out"]) or ".", "sweep",
+                                             description))
+        return argparse.Namespace(**values)
     parser = argparse.ArgumentParser(description=description,
                                      formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     for name, value in defaults.items():

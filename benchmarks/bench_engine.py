@@ -1,0 +1,137 @@
+"""Benchmark: the engine's cost per step and per breakage event, beside plain YADE.
+
+    /usr/bin/python3 benchmarks/bench_engine.py [--quick]
+
+1. Per step, with breakage out of reach (fracture energies set very high): plain YADE, the floor of
+   a no-op PyRunner at every step, yadebreak reading every contact every step (exact) and with
+   read_period="auto", on the default bed (37 particles, 3.05 J) and on a 5-layer, 4-ring bed.
+2. Per breakage event: the package's own work for a family drawn at t10' = 10 % in scenes of
+   1e3, 1e4 and 3e4 bodies, YADE's extra work on the next step, and yade.bf.replaceSphere
+   (YADE's own, 27 sub-spheres) on the same scenes.
+Prints figures and ratios measured in this run, and the peak memory.
+"""
+import resource
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
+
+import numpy as np  # noqa: E402
+
+from yadebreak import coupling, scenes  # noqa: E402
+from yadebreak.coupling import O, _wrapper, utils  # noqa: E402
+
+QUICK = "--quick" in sys.argv
+# O.run(n, True) polls for the end, which quantises one run's time to ~40 ms: many steps
+STEPS = 5000 if QUICK else 20000
+
+
+def bed_rate(rings, layers, mode):
+    """Microseconds per step during the impact, breakage out of reach."""
+    coupling._REGISTRY.clear()
+    options = {} if mode in ("plain", "noop") else {"read_period": 1 if mode == "exact" else "auto"}
+    brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, rings, layers, 3.05, seed=1,
+                                        **options)
+    for st in brk.bodies.values():
+        st.fracture_energy = 1e30
+    engines = list(O.engines)
+    if mode in ("plain", "noop"):
+        engines = [e for e in engines if not isinstance(e, _wrapper.PyRunner)]
+        if mode == "noop":
+            engines.insert(3, _wrapper.PyRunner(command="pass", iterPeriod=1))
+        O.engines = engines
+    while not any(O.interactions.withBody(info["ball"])):       # to the first touch
+        O.run(50, True)
+    scenes.hold_release(info)
+    start = time.perf_counter()
+    O.run(STEPS, True)
+    contacts = O.interactions.countReal()
+    return 1e6 * (time.perf_counter() - start) / STEPS, contacts
+
+
+def per_step_table():
+    print("\n1. Cost per step during the impact (breakage out of reach)")
+    for rings, layers, label in ((3, 1, "default bed (37 particles)"),
+                                 (4, 5, "5 layers x 4 rings")):
+        rates = {}
+        for mode in ("plain", "noop", "exact", "auto"):
+            rates[mode], contacts = bed_rate(rings, layers, mode)
+        plain, floor = rates["plain"], rates["noop"]
+        print(f"  {label}: {contacts} contacts")
+        print(f"    plain YADE            {plain:8.1f} us/step")
+        print(f"    + no-op PyRunner      {floor:8.1f} us/step  ({floor / plain:.2f} x plain)")
+        for mode in ("exact", "auto"):
+            own = rates[mode] - floor
+            print(f"    yadebreak {mode:5s}       {rates[mode]:8.1f} us/step  "
+                  f"({rates[mode] / plain:.2f} x plain; own work beyond the floor "
+                  f"{own:.1f} us = {own / plain:.2f} x YADE's step)")
+
+
+def cloud(n, dummies="spheres"):
+    """n spheres of 5.5 mm on a loose cubic grid (no contacts), and a controller."""
+    O.reset()
+    coupling._REGISTRY.clear()
+    ip2, _ = coupling.add_materials({"ore": "copper_ore"})
+    side = int(np.ceil(n ** (1 / 3)))
+    pitch = 6e-3
+    grid = [(i * pitch, j * pitch, k * pitch) for i in range(side) for j in range(side)
+            for k in range(side)][:n]
+    O.bodies.append([utils.sphere(p, 2.75e-3, material="ore") for p in grid])
+    O.engines = scenes.hertz_engines(ip2)
+    brk = coupling.attach({"ore": "copper_ore"}, seed=1, time_step_fraction=None,
+                          dummies=dummies)
+    O.dt = 1e-7
+    O.run(3, True)
+    return brk, side, pitch
+
+
+def event_table():
+    print("\n2. Cost of one breakage event (family at t10' = 10 %, up to 30 spheres)")
+    counts = (1000, 10000) if QUICK else (1000, 10000, 30000)
+    for n, dummies in [(n, d) for n in counts for d in ("spheres", "ledger")]:
+        brk, side, pitch = cloud(n, dummies)
+        mid = n // 2
+        victims = [mid + k for k in range(0, 40, 4)]
+        t_step = time.perf_counter()
+        O.run(20, True)
+        normal_step = (time.perf_counter() - t_step) / 20
+        own, extra, sizes = [], [], []
+        for v in victims[:5]:
+            table = brk.tables["ore"]
+            ratio = None
+            mat = brk.material["ore"]
+            # ratio whose Eq. 8 gives t10' = 10 %
+            ratio = -mat.kappa / mat.b_prime * np.log(1 - 10.0 / mat.A)
+            before = brk.wall_time["replace"]
+            ev = brk.break_body(v, ratio=ratio)
+            own.append(brk.wall_time["replace"] - before)
+            sizes.append(len(ev["fragments"]))
+            t0 = time.perf_counter()
+            O.step()
+            extra.append(time.perf_counter() - t0 - normal_step)
+        print(f"  {n:6d} bodies, dummies as {dummies}: yadebreak {1e3 * np.median(own):.2f} ms per event "
+              f"(families of {min(sizes)}-{max(sizes)} spheres); YADE's next step "
+              f"+{1e3 * np.median(extra):.2f} ms over a normal step ({1e3 * normal_step:.2f} ms)")
+        if dummies == "ledger":
+            continue
+        try:
+            from yade.bf import bf
+        except ImportError:
+            print("    yade.bf not available")
+            continue
+        refused, times = 0, []
+        for v in victims[5:10]:
+            t0 = time.perf_counter()
+            left = bf.replaceSphere(v, radius_ratio=3)
+            times.append(time.perf_counter() - t0)
+            refused += left is not None
+        print(f"    yade.bf.replaceSphere: {1e3 * np.median(times):.1f} ms per event "
+              f"({np.median(times) / np.median(own):.0f} x yadebreak), refused {refused} of 5")
+
+
+if __name__ == "__main__":
+    per_step_table()
+    event_table()
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"\npeak memory {peak:.0f} MB")

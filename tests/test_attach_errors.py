@@ -1,0 +1,83 @@
+"""Bad scenes and options get one clear message before the run starts (YADE)."""
+import warnings
+
+import pytest
+
+pytestmark = pytest.mark.yade
+
+
+def _scene(with_engines=True):
+    from yade import O, utils
+    from yadebreak import coupling, scenes
+    ip2, _ = coupling.add_materials({"ore": "copper_ore", "steel": "steel"})
+    O.bodies.append(utils.wall(0, axis=2, material="steel"))
+    O.bodies.append(utils.sphere((0, 0, 0.003), 0.00275, material="ore"))
+    if with_engines:
+        O.engines = scenes.hertz_engines(ip2)
+    return coupling
+
+
+def test_unknown_material_label(scene):
+    coupling = _scene()
+    with pytest.raises(coupling.AttachError, match=r"unknown YADE material label\(s\) \['rock'\].*'ore'"):
+        coupling.attach({"rock": "copper_ore"})
+
+
+def test_unknown_material_file(scene):
+    coupling = _scene()
+    with pytest.raises(coupling.AttachError, match="unknown material 'unobtainium'"):
+        coupling.attach({"ore": "unobtainium"})
+
+
+def test_attach_before_engines(scene):
+    coupling = _scene(with_engines=False)
+    with pytest.raises(coupling.AttachError, match="no InteractionLoop: set O.engines"):
+        coupling.attach({"ore": "copper_ore"})
+
+
+def test_attach_twice(scene):
+    coupling = _scene()
+    coupling.attach({"ore": "copper_ore"})
+    with pytest.raises(coupling.AttachError, match="already attached"):
+        coupling.attach({"ore": "copper_ore"})
+
+
+def test_non_sphere_with_breakable_material(scene):
+    from yade import O, utils
+    coupling = _scene()
+    O.bodies.append(utils.box((0.1, 0, 0.01), (0.005, 0.005, 0.005), material="ore"))
+    with pytest.raises(coupling.AttachError, match="Box.*only spheres can break"):
+        coupling.attach({"ore": "copper_ore"})
+
+
+def test_non_breakable_material_mapped(scene):
+    coupling = _scene()
+    with pytest.raises(coupling.AttachError, match="'steel' .* is not breakable"):
+        coupling.attach({"ore": "steel"})
+
+
+def test_scene_without_breakable_body_warns(scene):
+    from yade import O
+    coupling = _scene()
+    O.bodies.erase(1)
+    with pytest.warns(RuntimeWarning, match="no breakable body"):
+        brk = coupling.attach({"ore": "copper_ore"})
+    O.run(10, True)                       # and runs, doing nothing
+    assert brk.events == []
+
+
+@pytest.mark.parametrize("option, message", [
+    (dict(cs=2.0), r"cs = 2.0: accepted \[0, 1\]"),
+    (dict(emin=-1.0), "emin"),
+    (dict(emax_ratio=1.0), r"emax_ratio = 1.0: accepted > 1"),
+    (dict(dmin=-1e-3), "dmin"),
+    (dict(local_damping=1.5), "local_damping"),
+    (dict(time_step_fraction=0.0), "time_step_fraction"),
+    (dict(read_period=0), "read_period"),
+    (dict(dummies="dust"), "dummies"),
+    (dict(colour="red"), r"unknown option\(s\) \['colour'\]"),
+])
+def test_bad_options(scene, option, message):
+    coupling = _scene()
+    with pytest.raises(coupling.AttachError, match=message):
+        coupling.attach({"ore": "copper_ore"}, **option)
