@@ -55,7 +55,7 @@ for k, energy in enumerate(float(e) for e in args.energies.split(",")):
     }
     if args.replace and n_broken:
         parent_mass = sum(e["mass"] for e in broken)
-        sieves = args.size * np.geomspace(1e-3, 1.0, 40)
+        sieves = args.size * np.geomspace(1e-3, 0.99, 40)   # below the feed size: progeny only
         sd = brk.size_distribution(sieves)
         # passing mass below the feed size comes from the progeny only
         progeny_passing = 100 * sd.passing_mass / parent_mass

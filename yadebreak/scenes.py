@@ -154,3 +154,34 @@ def hold_release(info):
         info["holder"] = []
         return True
     return False
+
+
+def drop_weight_scene(material="copper_ore", size=5.5e-3, specific_energy=200.0, particles=50,
+                      striker_mass_ratio=50.0, seed=0, **options):
+    """Drop-weight tests: a steel striker (a sphere of striker_mass_ratio x the particle's mass)
+    falls on each particle resting on a steel anvil, with Ek / mp = specific_energy. The energy
+    of both contacts (striker-particle, particle-anvil) is counted (Eq. 14).
+    Returns (controller, particle ids, striker ids)."""
+    O.reset()
+    ip2, mats = add_materials({"particle": material, "steel": "steel"},
+                              stiffness_scale=options.pop("stiffness_scale", 1.0))
+    O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="steel"))
+    radius = size / 2.0
+    mat = mats["particle"]
+    particle_mass = mat.density * 4.0 / 3.0 * math.pi * radius ** 3
+    striker_mass = striker_mass_ratio * particle_mass
+    striker_radius = (striker_mass / (7800.0 * 4.0 / 3.0 * math.pi)) ** (1.0 / 3.0)
+    speed = math.sqrt(2.0 * specific_energy * particle_mass / striker_mass)
+    pitch = 2.5 * striker_radius + size
+    side = int(math.ceil(math.sqrt(particles)))
+    ids, strikers = [], []
+    for k in range(particles):
+        x, y = (k % side) * pitch, (k // side) * pitch
+        ids.append(O.bodies.append(utils.sphere((x, y, radius), radius, material="particle")))
+        s = utils.sphere((x, y, size + striker_radius * 1.001 + 0.02 * radius), striker_radius,
+                         material="steel")
+        s.state.vel = (0.0, 0.0, -speed)
+        strikers.append(O.bodies.append(s))
+    O.engines = hertz_engines(ip2)
+    brk = attach({"particle": material}, seed=seed, **options)
+    return brk, ids, strikers
