@@ -405,6 +405,7 @@ class Breakage:
                 c[9] = fs
             seen[key] = c
             total = c[2] + cs * c[10]
+            # the two endpoints written out, not looped: this runs for every contact every read
             if ta is not None:
                 touching.setdefault(a, []).append((c, 3))
                 own = total - c[3]

@@ -1,0 +1,74 @@
+"""Results of impact tests, shared by the scripts: first events, breakage against the model,
+progeny size distribution and t10 against Eqs. 8 and 10, and the two-panel plot. No yade import:
+`brk` is any object with `events` and `size_distribution` (the coupling's controller)."""
+from __future__ import annotations
+
+import numpy as np
+
+from . import model
+
+
+def first_events(events, ids):
+    """Each listed particle's first event (the impact itself), or none."""
+    first = {}
+    for e in events:
+        first.setdefault(e["id"], e)
+    return {i: first[i] for i in ids if i in first}
+
+
+def breakage_result(brk, ids, material, size, specific_energy, partner):
+    """Broken fraction of the particles `ids` beside the model's probability P(e Ek/mp), and,
+    when any broke, the progeny's size distribution (fines included, sieves below the feed size)
+    and t10 beside Eq. 8 (mean over the events) and Eq. 10."""
+    first = first_events(brk.events, ids)
+    broken = [e for e in first.values() if e["kind"] == "breakage"]
+    p_model = float(material.breakage_probability(specific_energy, size, partner=partner))
+    n = len(ids)
+    result = {"specific_energy": specific_energy, "particles": n,
+              "broken_fraction": len(broken) / n, "model_probability": p_model,
+              "binomial_sigma": float(np.sqrt(p_model * (1 - p_model) / n))}
+    if broken:
+        parent_mass = sum(e["mass"] for e in broken)
+        sieves = size * np.geomspace(1e-3, 0.99, 40)    # below the feed size: progeny only
+        t10_events = np.array([e["t10"] for e in broken])
+        passing = 100 * brk.size_distribution(sieves).passing_mass / parent_mass
+        result.update({
+            "t10_simulated": float(100 * brk.size_distribution([size / 10]).passing_mass[0]
+                                   / parent_mass),
+            "t10_model_eq8": float(t10_events.mean()),
+            "relative_sizes": (sieves / size).tolist(),
+            "progeny_passing_simulated": passing.tolist(),
+            "progeny_passing_model": model.progeny_passing(
+                t10_events, material.beta_params, sieves / size).mean(axis=0).tolist()})
+    return result
+
+
+def plot_breakage(results, material, size, partner, title, path, label="simulation"):
+    """Broken fraction against specific energy (model line, simulation with 3 sigma) and the
+    progeny size distributions (model lines, simulation symbols), to a PNG."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    energies = [r["specific_energy"] for r in results]
+    grid = np.geomspace(min(energies) / 3, max(energies) * 3, 200)
+    axes[0].semilogx(grid, 100 * material.breakage_probability(grid, size, partner=partner), "k-",
+                     label="model (Eqs. 1-4)")
+    axes[0].errorbar(energies, [100 * r["broken_fraction"] for r in results],
+                     yerr=[300 * r["binomial_sigma"] for r in results], fmt="o", c="C3",
+                     label=f"{label} (3 sigma)")
+    axes[0].set(xlabel="specific energy Ek/mp (J/kg)", ylabel="broken (%)", title=title)
+    axes[0].legend()
+    for k, r in enumerate(results):
+        if "relative_sizes" in r:
+            axes[1].semilogx(r["relative_sizes"], r["progeny_passing_model"], "-", c=f"C{k}",
+                             label=f"model, {r['specific_energy']:g} J/kg")
+            axes[1].semilogx(r["relative_sizes"], r["progeny_passing_simulated"], "o", ms=4,
+                             c=f"C{k}", label=f"simulation, t10 {r['t10_simulated']:.1f} % "
+                                              f"(Eq. 8: {r['t10_model_eq8']:.1f} %)")
+    axes[1].set(xlabel="relative size d / d_parent", ylabel="progeny passing (%)",
+                title="progeny of broken particles (fines included)")
+    axes[1].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
