@@ -348,6 +348,10 @@ class Breakage:
 
     # -- the per-step work -------------------------------------------------------------------------
     def step(self):
+        if not self.tracked and not self.open_events:
+            self._release_damping()
+            self.last_iter = O.iter           # nothing can break: next to no cost
+            return
         t0 = time.perf_counter()
         opts = self.options
         emin = opts.emin
