@@ -98,8 +98,6 @@ def event_table():
         normal_step = (time.perf_counter() - t_step) / 20
         own, extra, sizes = [], [], []
         for v in victims[:5]:
-            table = brk.tables["ore"]
-            ratio = None
             mat = brk.material["ore"]
             # ratio whose Eq. 8 gives t10' = 10 %
             ratio = -mat.kappa / mat.b_prime * np.log(1 - 10.0 / mat.A)

@@ -10,7 +10,6 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-import numpy as np  # noqa: E402
 
 from yadebreak import load_material, reports  # noqa: E402
 from yadebreak.scriptargs import progress, script_params  # noqa: E402

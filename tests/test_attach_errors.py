@@ -1,6 +1,4 @@
 """Bad scenes and options get one clear message before the run starts (YADE)."""
-import warnings
-
 import pytest
 
 pytestmark = pytest.mark.yade

@@ -27,7 +27,7 @@ import os
 import sys
 import time
 import warnings
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -838,10 +838,10 @@ def _find_engine(label):
 
 
 def _controller(label):
+    """The controller of `label`, restored from O.tags when the scene was loaded or went back in
+    time (its iteration is not the one that follows the controller's last read)."""
     ctl = _REGISTRY.get(label)
     stale = ctl is None or O.iter <= ctl.last_iter or O.iter > ctl.last_iter + ctl.period
-    if stale and ctl is not None and ctl.last_iter < 0:
-        stale = False
     if stale:
         if _TAG + label not in O.tags.keys():
             raise AttachError(f"yadebreak engine '{label}' has no state in this scene")
@@ -859,10 +859,7 @@ def _run(label):
 
 def _run_zero(label):
     """Called by the PyRunner before the InteractionLoop."""
-    ctl = _REGISTRY.get(label)
-    if ctl is None or O.iter <= ctl.last_iter or O.iter > ctl.last_iter + 1:
-        ctl = _controller(label)
-    ctl.zero_overlaps()
+    _controller(label).zero_overlaps()
 
 
 # keep the state in O.tags whenever the scene is saved
