@@ -79,3 +79,12 @@ def test_bad_options(scene, option, message):
     coupling = _scene()
     with pytest.raises(coupling.AttachError, match=message):
         coupling.attach({"ore": "copper_ore"}, **option)
+
+
+def test_time_step_too_large_warns_with_the_remedy(scene):
+    from yade import O
+    coupling = _scene()
+    O.dt = 1e-6                     # the 5.5 mm sphere's Rayleigh time is 3.5e-6 s
+    with pytest.warns(RuntimeWarning, match=r"O.dt = 1e-06 s is 28 % of the Rayleigh time.*time_step_fraction"):
+        coupling.attach({"ore": "copper_ore"}, time_step_fraction=None)
+    assert O.dt == 1e-6             # the user's time step is left alone

@@ -624,10 +624,13 @@ class Breakage:
             self._zero_engine().dead = False
         if opts.global_damping > 0.0:
             self.damped_until.append((O.time + opts.global_damping_time, list(ids)))
-        if opts.time_step_fraction and len(ids):
-            tr = placement.rayleigh_time(radii.min(), material.density, material.young,
-                                         material.poisson)
-            self._pending_dt = min(self._pending_dt, float(opts.time_step_fraction * tr))
+        if len(ids):
+            tr = float(placement.rayleigh_time(radii.min(), material.density, material.young,
+                                               material.poisson))
+            if opts.time_step_fraction:
+                self._pending_dt = min(self._pending_dt, opts.time_step_fraction * tr)
+            else:
+                self._check_time_step(tr)
         return new_ids, fam.t10
 
     def _zero_new(self, ids, centers, radii, ii, jj, overlap, neighbours):
@@ -657,6 +660,15 @@ class Breakage:
                 artificial = ov[k] - real if k == keeper else ov[k]
                 if artificial > 0.0:
                     self._zero_pair(ids[k], other, float(artificial), created=created)
+
+    def _check_time_step(self, rayleigh_time):
+        """With time_step_fraction=None the user owns O.dt: warn once when it exceeds 20 % of the
+        Rayleigh time of the smallest sphere present (Hertz contacts go unstable near it)."""
+        if O.dt > 0.2 * rayleigh_time:
+            self._warn_once("dt", (
+                f"O.dt = {O.dt:.3g} s is {100 * O.dt / rayleigh_time:.0f} % of the Rayleigh time of "
+                f"the smallest sphere ({rayleigh_time:.3g} s): contacts may go unstable and energies "
+                f"be wrong; use time_step_fraction (0.05 recommended) or lower O.dt"))
 
     def _lower_time_step(self, new_dt):
         """O.dt = new_dt, keeping the leapfrog exact across the change.
@@ -927,13 +939,15 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
             for b in O.bodies:                 # global damping acts on fresh fragments only
                 if b is not None:
                     b.state.isDamped = False
-    if opts.time_step_fraction:
-        radii = [(b.shape.radius, b.material) for b in O.bodies
-                 if b is not None and isinstance(b.shape, _wrapper.Sphere)]
-        if radii:
-            tr = min(float(placement.rayleigh_time(r, m.density, m.young, m.poisson))
-                     for r, m in radii)
+    radii = [(b.shape.radius, b.material) for b in O.bodies
+             if b is not None and isinstance(b.shape, _wrapper.Sphere)]
+    if radii:
+        tr = min(float(placement.rayleigh_time(r, m.density, m.young, m.poisson))
+                 for r, m in radii)
+        if opts.time_step_fraction:
             O.dt = opts.time_step_fraction * tr
+        else:
+            ctl._check_time_step(tr)
     if opts.event_log:
         Path(opts.event_log).parent.mkdir(parents=True, exist_ok=True)
         open(opts.event_log, "w").close()
