@@ -57,3 +57,30 @@ def test_bed_script_runs_headless(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["final_mass"] == pytest.approx(summary["initial_mass"], rel=1e-9)
     assert "[yadebreak] done in" in proc.stdout
+
+
+def test_resume_continues_exactly_like_an_uninterrupted_run(scene, tmp_path):
+    """A run that dies after a checkpoint and goes on with --resume gives the same results."""
+    from yadebreak import bed, coupling
+    from yade import O
+    whole = _args(tmp_path / "whole", 0.9, seed=5)
+    whole.checkpoint_every = -1                    # never
+    _, reference = bed.run(whole, quiet=True)
+    reference_events = (tmp_path / "whole" / "events.jsonl").read_text()
+
+    coupling._REGISTRY.clear()
+    O.reset()
+    died = _args(tmp_path / "died", 0.9, seed=5)
+    died.checkpoint_every = 0.0                    # after every chunk
+    died.stop_after = 6e-4          # dies here: after the first breakage (0.40 ms), before the rest
+    brk, summary = bed.run(died, quiet=True)
+    assert summary is None and (tmp_path / "died" / "checkpoint.yade.gz").exists()
+    assert 0 < len(brk.breakage_events) < reference["breakage_events"]
+    coupling._REGISTRY.clear()
+    O.reset()
+    died.stop_after, died.resume = 0.0, True
+    _, resumed = bed.run(died, quiet=True)
+    for key in ("broken_mass", "breakage_events", "damage_events", "final_mass", "capture_radius",
+                "steps", "simulated_time"):
+        assert resumed[key] == reference[key], key
+    assert (tmp_path / "died" / "events.jsonl").read_text() == reference_events

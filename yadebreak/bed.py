@@ -9,12 +9,13 @@ from pathlib import Path
 
 import numpy as np
 
-from . import scenes
+from . import coupling, scenes
 from .coupling import O
 from .scriptargs import progress
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
 TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
+_LOOP_TAG = "yadebreak_bed"
 
 
 def _fates(brk, particles):
@@ -62,6 +63,27 @@ def write_vtk(path, brk):
         f.writelines(f"{r[6]}\n" for r in rows)
 
 
+def _checkpoint(path, info, loop):
+    """O.save the scene (yadebreak's state travels in O.tags) with the loop's own state."""
+    O.tags[_LOOP_TAG] = json.dumps({
+        "loop": loop, "info": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                               for k, v in info.items() if k != "material"}})
+    tmp = path.with_name(path.name + ".tmp.yade.gz")
+    O.save(str(tmp))
+    tmp.replace(path)
+
+
+def _resume(path):
+    if not path.exists():
+        raise SystemExit(f"--resume: no checkpoint at {path}; run without --resume first "
+                         "(checkpoints are written every --checkpoint-every seconds)")
+    O.load(str(path))
+    data = json.loads(O.tags[_LOOP_TAG])
+    info = data["info"]
+    info["centers"] = np.array(info["centers"])
+    return coupling._controller("yadebreak"), info, data["loop"]
+
+
 def run(args, quiet=False):
     """Build, run and report one bed impact. Returns (controller, summary dict)."""
     out = Path(args.out)
@@ -75,24 +97,33 @@ def run(args, quiet=False):
     if args.global_damping > 0:
         options.update(global_damping=args.global_damping, global_damping_time=5e-4)
     start = time.time()
-    brk, info = scenes.bed_impact_scene(args.material, args.size, args.rings, args.layers,
-                                        energy, args.seed, **options)
     say = (lambda m: None) if quiet else progress
-    say(f"{len(info['particles'])} particles of {args.material} ({1e3 * args.size:g} mm), "
-        f"{args.layers} layer(s); ball at {info['speed']:.3f} m/s ({energy:g} J); dt {O.dt:.3g} s")
-    initial_mass = brk.total_mass()
+    checkpoint = out / "checkpoint.yade.gz"
+    if getattr(args, "resume", False):
+        brk, info, loop = _resume(checkpoint)
+        say(f"resumed from {checkpoint} at t = {1e3 * O.time:.3f} ms, iteration {O.iter}")
+    else:
+        brk, info = scenes.bed_impact_scene(args.material, args.size, args.rings, args.layers,
+                                            energy, args.seed, **options)
+        loop = {"touched": None, "turned": None, "initial_mass": brk.total_mass()}
+        say(f"{len(info['particles'])} particles of {args.material} ({1e3 * args.size:g} mm), "
+            f"{args.layers} layer(s); ball at {info['speed']:.3f} m/s ({energy:g} J); "
+            f"dt {O.dt:.3g} s")
+    initial_mass = loop["initial_mass"]
     ball = O.bodies[info["ball"]]
     v0 = info["speed"]
-    touched = turned = None
-    last_report = start
+    every = getattr(args, "checkpoint_every", 60.0)
+    stop_after = getattr(args, "stop_after", 0.0)
+    last_report = last_checkpoint = start
     while True:
-        O.run(100 if touched is None else 400, True)
-        if touched is None and any(O.interactions.withBody(info["ball"])):
-            touched = O.time
+        O.run(100 if loop["touched"] is None else 400, True)
+        if loop["touched"] is None and any(O.interactions.withBody(info["ball"])):
+            loop["touched"] = O.time
             scenes.hold_release(info)
         vz = ball.state.vel[2]
-        if touched is not None and turned is None and vz >= 0.0:
-            turned = O.time                    # deepest penetration: loading is over
+        if loop["touched"] is not None and loop["turned"] is None and vz >= 0.0:
+            loop["turned"] = O.time            # deepest penetration: loading is over
+        touched, turned = loop["touched"], loop["turned"]
         # breakage happens while loading: after the turn, a short unloading, then open events
         # are closed with their largest energy (brk.finish)
         if turned is not None and O.time >= turned + TAIL:
@@ -101,6 +132,11 @@ def run(args, quiet=False):
             say(f"stopped at max_time = {args.max_time} s of simulated time")
             break
         now = time.time()
+        if every >= 0 and now - last_checkpoint >= every:
+            _checkpoint(checkpoint, info, loop)   # a run that dies goes on with --resume 1
+            last_checkpoint = now
+        if stop_after and O.time >= stop_after:
+            return brk, None                      # (tests) as if the run had died here
         if now - last_report > 5.0:
             done = 0.0 if touched is None else (0.5 * (1 - max(-vz, 0.0) / v0) if turned is None
                                                 else 0.5 + 0.5 * (O.time - turned) / TAIL)
