@@ -20,6 +20,7 @@ produces Hertz-Mindlin force (see ../shared/YADE.md).
 """
 from __future__ import annotations
 
+import dataclasses
 import heapq
 import json
 import math
@@ -181,7 +182,6 @@ class Breakage:
                                   "breakable materials in attach(materials=...)")
             opts = self.options
             if opts.kappa is not None or opts.emax_ratio is not None:
-                import dataclasses
                 mat = dataclasses.replace(mat, **{k: v for k, v in (
                     ("kappa", opts.kappa), ("emax_ratio", opts.emax_ratio)) if v is not None})
             self.material[lab] = mat
@@ -197,11 +197,11 @@ class Breakage:
         self.tables = {lab: families.table_for(mat, self.options.family_seed)
                        for lab, mat in self.material.items()}
 
-    def _register_bodies(self, ids=None):
-        """Give every breakable sphere (or the given ids) its state and fracture energy."""
+    def _register_bodies(self):
+        """Give every breakable sphere of the scene its state and fracture energy."""
         found = []
         problems = []
-        for b in (O.bodies if ids is None else (O.bodies[i] for i in ids)):
+        for b in O.bodies:
             if b is None or b.id in self.bodies:
                 continue
             mid = b.material.id if b.material is not None else None
@@ -264,13 +264,17 @@ class Breakage:
     def finish(self):
         """Close every open stressing event as if its body had unloaded (damage with the event's
         largest energy), for runs stopped once the loading is over. Returns how many."""
+        touching = {}                            # one pass over the contacts
+        for (a, b), c in self.contacts.items():
+            if a in self.open_events:
+                touching.setdefault(a, []).append((c, 3))
+            if b in self.open_events:
+                touching.setdefault(b, []).append((c, 4))
         closed = 0
         for bid in list(self.open_events):
             st = self.tracked.get(bid)
             if st is not None and st.event_max > 0.0:
-                touching = [(c, 3 if key[0] == bid else 4) for key, c in self.contacts.items()
-                            if bid in key]
-                self._close_event(bid, st, touching)
+                self._close_event(bid, st, touching.get(bid, ()))
                 closed += 1
         self.open_events.clear()
         return closed
@@ -378,19 +382,19 @@ class Breakage:
                 g = i.geom
                 if g is None:
                     continue
-                ph = i.phys
                 ka = stiff[bodies[a].material.id]
                 kb = stiff[bodies[b].material.id]
-                # [delta, force, En, offset_a, offset_b, kno, e_a, e_b, us, Fs, Es, geom, phys]
+                # [delta, force, En, offset_a, offset_b, e_a, e_b, us, Fs, Es, geom, phys]
                 # (the last two: wrappers kept while the contact lives, never saved)
-                c = [0.0, 0.0, 0.0, 0.0, 0.0, ph.kno,
-                     1.0 / (1.0 + ka / kb), 1.0 / (1.0 + kb / ka), 0.0, 0.0, 0.0, g, ph]
+                c = [0.0, 0.0, 0.0, 0.0, 0.0,
+                     float(model.energy_partition(ka, kb)), float(model.energy_partition(kb, ka)),
+                     0.0, 0.0, 0.0, g, i.phys]
                 contacts[key] = c
-            elif len(c) == 11:                     # restored from O.tags: wrappers again
+            elif len(c) == 10:                     # restored from O.tags: wrappers again
                 c += [i.geom, i.phys]
-            g = c[11]
+            g = c[10]
             delta = g.penetrationDepth
-            force = c[12].normalForce.norm()      # compressive while the overlap grows
+            force = c[11].normalForce.norm()      # compressive while the overlap grows
             if delta > c[0]:
                 c[2] += 0.5 * (c[1] + force) * (delta - c[0])
                 if ta is not None:
@@ -400,21 +404,21 @@ class Breakage:
             c[0] = delta
             c[1] = force
             if cs > 0.0:
-                ph = c[12]
+                ph = c[11]
                 us = ph.usTotal.norm()
                 fs = ph.shearForce.norm()
-                if us > c[8]:
-                    c[10] += 0.5 * (c[9] + fs) * (us - c[8])
-                c[8] = us
-                c[9] = fs
+                if us > c[7]:
+                    c[9] += 0.5 * (c[8] + fs) * (us - c[7])
+                c[7] = us
+                c[8] = fs
             seen[key] = c
-            total = c[2] + cs * c[10]
+            total = c[2] + cs * c[9]
             # the two endpoints written out, not looped: this runs for every contact every read
             if ta is not None:
                 touching.setdefault(a, []).append((c, 3))
                 own = total - c[3]
                 if own >= emin:
-                    share = c[6] * own
+                    share = c[5] * own
                     energy[a] = energy.get(a, 0.0) + share
                     if share > strongest.get(a, (0.0,))[0]:
                         strongest[a] = (share, g.normal, 1.0)      # normal points a -> b
@@ -422,7 +426,7 @@ class Breakage:
                 touching.setdefault(b, []).append((c, 4))
                 own = total - c[4]
                 if own >= emin:
-                    share = c[7] * own
+                    share = c[6] * own
                     energy[b] = energy.get(b, 0.0) + share
                     if share > strongest.get(b, (0.0,))[0]:
                         strongest[b] = (share, g.normal, -1.0)
@@ -488,8 +492,8 @@ class Breakage:
         cs = self.options.cs
         total = 0.0
         for c, slot in touching:
-            if c[2] + cs * c[10] - c[slot] >= emin and c[0] > 0.0:
-                total += c[6 if slot == 3 else 7] * 0.4 * c[12].kno * c[0] ** 2.5
+            if c[2] + cs * c[9] - c[slot] >= emin and c[0] > 0.0:
+                total += c[5 if slot == 3 else 6] * 0.4 * c[11].kno * c[0] ** 2.5
         return total
 
     def _close_event(self, bid, st, touching):
@@ -508,7 +512,7 @@ class Breakage:
         st.specific_energy = 0.0
         self.open_events.discard(bid)
         for c, slot in touching:            # the next event starts from the present state
-            c[slot] = c[2] + self.options.cs * c[10]
+            c[slot] = c[2] + self.options.cs * c[9]
 
     # -- breakage and replacement ----------------------------------------------------------------
     def _break_all(self, broken, contacts):
@@ -791,7 +795,7 @@ class Breakage:
                 "rng": self.rng.bit_generator.state, "iter": O.iter, "top_size": self.top_size,
                 "bodies": {str(k): v.as_dict() for k, v in self.bodies.items()},
                 "tracked": sorted(self.tracked),
-                "contacts": [[k[0], k[1], c[:11]] for k, c in self.contacts.items()],
+                "contacts": [[k[0], k[1], c[:10]] for k, c in self.contacts.items()],
                 "zeroed": [[k[0], k[1], z] for k, z in self.zeroed.items()],
                 "damped_until": self.damped_until, "events": self.events, "ledger": self.ledger,
                 "warned": sorted(self.warned)}

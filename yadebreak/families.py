@@ -289,17 +289,17 @@ class FamilyTable:
         i = bisect.bisect_right(cum, rng.random() * cum[-1])
         return fams[min(i, len(fams) - 1)]
 
-    # -- disk cache ------------------------------------------------------------------------------
-    def _key(self):
-        text = json.dumps([_FORMAT_VERSION, sorted(self.beta_params.items()), self.t10_min,
-                           self.t10_max, self.seed, _POOL_SIZE, TABLE_RATIO])
-        return hashlib.sha256(text.encode()).hexdigest()[:20]
-
 
 def _cache_dir():
     base = os.environ.get("YADEBREAK_CACHE") or os.path.join(
         os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "yadebreak")
     return Path(base)
+
+
+def _cache_key(beta_key, t10_min, t10_max, seed):
+    """Names a table's file: everything that decides its content."""
+    text = json.dumps([_FORMAT_VERSION, beta_key, t10_min, t10_max, seed, _POOL_SIZE, TABLE_RATIO])
+    return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
 def _beta_key(beta_params):
@@ -308,10 +308,8 @@ def _beta_key(beta_params):
 
 @lru_cache(maxsize=64)
 def _table_cached(beta_key, t10_min, t10_max, seed):
-    beta_params = dict((k, v) for k, v in beta_key)
-    probe = FamilyTable.__new__(FamilyTable)
-    probe.beta_params, probe.t10_min, probe.t10_max, probe.seed = beta_params, t10_min, t10_max, seed
-    path = _cache_dir() / f"families-{probe._key()}.npz"
+    beta_params = dict(beta_key)
+    path = _cache_dir() / f"families-{_cache_key(beta_key, t10_min, t10_max, seed)}.npz"
     if path.exists():
         try:
             data = np.load(path)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
 from typing import Mapping
@@ -68,7 +68,6 @@ class Material:
     device_stiffness: float = model.DEVICE_STIFFNESS_STEEL
     beta_params: Mapping[float, tuple] | None = None
     beta_source: str | None = None
-    extra: Mapping[str, float] = field(default_factory=lambda: MappingProxyType({}))
 
     # -- stiffness ---------------------------------------------------------------------------
     @property
