@@ -10,8 +10,8 @@ BREAKABLE = [n for n in available_materials() if load_material(n).breakable]
 
 def _grid(mat):
     # the primary-breakage minimum, interior points, and near A
-    return np.concatenate([[mat.t10_min], np.geomspace(mat.t10_min * 1.3, mat.A * 0.9, 4),
-                           [mat.A * 0.999]])
+    return np.concatenate([[mat.t10_min], np.geomspace(mat.t10_min * 1.3, mat.t10_ceiling * 0.9, 4),
+                           [mat.t10_ceiling * 0.999]])
 
 
 @pytest.mark.parametrize("name", BREAKABLE)

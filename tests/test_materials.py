@@ -21,7 +21,7 @@ def test_every_shipped_material_loads():
         assert mat.name == name
         if mat.breakable:
             assert set(mat.beta_params) == set(model.N_VALUES)
-            assert 0 < mat.t10_min < mat.A
+            assert 0 < mat.t10_min < mat.t10_ceiling
 
 
 def test_units_converted_to_si_once():

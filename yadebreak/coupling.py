@@ -90,6 +90,10 @@ def add_materials(labels, stiffness_scale=1.0):
     return ip2, mats
 
 
+#: Rocky's pause after a breakage event, in steps (seed 002, Section 2.4.2).
+AB_T10_PAUSE_STEPS = 25
+
+
 # ------------------------------------------------------------------------------- per-body state
 @dataclass
 class BodyState:
@@ -108,6 +112,12 @@ class BodyState:
                                    # dummy: t10' of the event that made it
     parent_size: float = math.nan  # dummy: the parent's diameter (m)
     generation: int = 0
+    pause_until: int = -1          # no energy is counted before this iteration (fresh fragments)
+    # Ab-T10 (MODEL.md Section 9); fracture_energy is then the e_cum at which the body breaks
+    e_min: float = 0.0             # J/kg, Eq. 9.1 at its size
+    e_cum: float = 0.0             # J/kg, Eq. 9.2
+    e_max: float = 0.0             # J/kg, Eq. 9.2
+    e_prev: float = 0.0            # J/kg, specific energy at the previous read
 
     def as_dict(self):
         return asdict(self)
@@ -133,6 +143,9 @@ class Options:
     family_seed: int = 0
     zero_overlaps: bool = True      # False only to show what the zeroing prevents
     dummies: str = "spheres"        # "spheres" (the paper) or "ledger" (fines kept outside the DEM)
+    pause_steps: int | None = None  # steps after its creation during which a fragment counts no
+                                    # energy (Rocky's safeguard); None: 25 for Ab-T10, 0 for Tavares
+    fragments_energy_factor: float = 1.0   # multiplies the specific energy seen by fragments
 
 
 # ------------------------------------------------------------------------------- the controller
@@ -181,7 +194,7 @@ class Breakage:
                 raise AttachError(f"material '{mat.name}' (label '{lab}') is not breakable: map only "
                                   "breakable materials in attach(materials=...)")
             opts = self.options
-            if opts.kappa is not None or opts.emax_ratio is not None:
+            if (opts.kappa is not None or opts.emax_ratio is not None) and not mat.is_ab_t10:
                 mat = dataclasses.replace(mat, **{k: v for k, v in (
                     ("kappa", opts.kappa), ("emax_ratio", opts.emax_ratio)) if v is not None})
             self.material[lab] = mat
@@ -196,6 +209,11 @@ class Breakage:
                 self.material_by_id[m.id] = (m.label, self.material[m.label])
         self.tables = {lab: families.table_for(mat, self.options.family_seed)
                        for lab, mat in self.material.items()}
+        self.ab_t10_labels = {lab for lab, mat in self.material.items() if mat.is_ab_t10}
+        pause = self.options.pause_steps
+        self.pause_steps = {lab: (pause if pause is not None else
+                                  (AB_T10_PAUSE_STEPS if mat.is_ab_t10 else 0))
+                            for lab, mat in self.material.items()}
 
     def _register_bodies(self):
         """Give every breakable sphere of the scene its state and fracture energy."""
@@ -234,6 +252,8 @@ class Breakage:
             st = BodyState(kind="breakable", material=label, mass=b.state.mass,
                            radius=b.shape.radius, fracture_energy=float(energies[k]),
                            fracture_energy_initial=float(energies[k]))
+            if label in self.ab_t10_labels:
+                st.e_min = float(self.material[label].min_energy(sizes[k]))
             self._adopt(b, st)
         self.top_size = max(self.top_size, float(sizes.max()))
         return found
@@ -258,6 +278,8 @@ class Breakage:
         if st is None or st.kind != "breakable":
             raise ValueError(f"body {body_id} is not a breakable body yadebreak tracks")
         ek = ratio * st.mass * st.fracture_energy
+        if st.material in self.ab_t10_labels:
+            st.e_cum = ratio * st.fracture_energy       # as if e_cum had reached ratio x threshold
         self._break_all([(body_id, st, ek, (ek, direction, 1.0))], self.contacts)
         return self.events[-1]
 
@@ -435,36 +457,75 @@ class Breakage:
 
         broken = []
         open_events = self.open_events
+        now = O.iter
+        factor = opts.fragments_energy_factor
+        ab_labels = self.ab_t10_labels
+        ab_bodies = []
         for bid in list(open_events.union(energy)):
             st = tracked.get(bid)
             if st is None:
                 open_events.discard(bid)
                 continue
+            if st.pause_until > now:
+                # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
+                # did meanwhile is never counted later
+                for c, slot in touching.get(bid, ()):
+                    c[slot] = c[2] + cs * c[9]
+                st.event_max = st.specific_energy = 0.0
+                open_events.discard(bid)
+                continue
             ek = energy.get(bid, 0.0)
+            if st.generation and factor != 1.0:
+                ek *= factor
             specific = ek / st.mass
+            if st.material in ab_labels:
+                ab_bodies.append((bid, st, ek, specific))
+                continue
             if specific > st.fracture_energy:
                 if specific - st.specific_energy > 0.8 * st.fracture_energy and st.specific_energy > 0:
-                    self._warn_once("jump", (
-                        f"specific energy rose by {100 * (specific - st.specific_energy) / st.fracture_energy:.0f} % "
-                        f"of the fracture energy between two reads at body {bid} (read every "
-                        f"{self.period} step(s) of {O.dt:.3g} s): reduce time_step_fraction (or "
-                        f"read_fraction / read_period) for an accurate t10'"))
+                    self._warn_jump(bid, specific - st.specific_energy, st.fracture_energy)
                 st.specific_energy = specific
                 broken.append((bid, st, ek, strongest.get(bid)))
                 continue
-            st.specific_energy = specific
-            if ek > st.event_max:
-                st.event_max = ek
-                open_events.add(bid)
-            elif (st.event_max > 0.0 and bid not in grew
-                  and self._stored_share(touching.get(bid, ())) <= emin):
-                self._close_event(bid, st, touching.get(bid, ()))
+            self._follow_event(bid, st, ek, specific, grew, touching)
+        if ab_bodies:
+            # Eq. 9.2 for every Ab-T10 body read now, in one call
+            e_cum, e_max = model.ab_t10_update(
+                [x[3] for x in ab_bodies], [x[1].e_prev for x in ab_bodies],
+                [x[1].e_cum for x in ab_bodies], [x[1].e_max for x in ab_bodies],
+                [x[1].e_min for x in ab_bodies])
+            for (bid, st, ek, specific), cum, top in zip(ab_bodies, e_cum.tolist(), e_max.tolist()):
+                rise = cum - st.e_cum
+                st.e_cum, st.e_max, st.e_prev = cum, top, specific
+                if cum > st.fracture_energy:
+                    if rise > 0.8 * st.fracture_energy:
+                        self._warn_jump(bid, rise, st.fracture_energy)
+                    st.specific_energy = specific
+                    broken.append((bid, st, ek, strongest.get(bid)))
+                else:
+                    self._follow_event(bid, st, ek, specific, grew, touching)
         if broken:
             self._break_all(broken, seen)
         self._release_damping()
         self.last_iter = O.iter
         if self.options.read_period == "auto":
             self._auto_period()
+
+    def _follow_event(self, bid, st, ek, specific, grew, touching):
+        """Keep a stressing event open while its energy grows; close it once the body unloads."""
+        st.specific_energy = specific
+        if ek > st.event_max:
+            st.event_max = ek
+            self.open_events.add(bid)
+        elif (st.event_max > 0.0 and bid not in grew
+              and self._stored_share(touching.get(bid, ())) <= self.options.emin):
+            self._close_event(bid, st, touching.get(bid, ()))
+
+    def _warn_jump(self, bid, rise, scale):
+        self._warn_once("jump", (
+            f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
+            f"two reads at body {bid} (read every {self.period} step(s) of {O.dt:.3g} s): reduce "
+            "time_step_fraction (or read_fraction / read_period) for an accurate t10'"))
 
     def _auto_period(self):
         """Read every k steps, k dt <= read_fraction T_R of the smallest breakable body."""
@@ -500,7 +561,18 @@ class Breakage:
         """End of a stressing event without breakage: Eqs. 5-6 with the event's largest Ek'."""
         ratio = st.event_max / (st.mass * st.fracture_energy)
         before = st.fracture_energy
-        if st.kind == "breakable":
+        if st.material in self.ab_t10_labels:
+            # Eq. 9.2 at the unloading: e_t = 0 < e_min resets e_max; e_cum keeps the damage
+            st.e_cum, st.e_max = (float(v) for v in model.ab_t10_update(
+                0.0, st.e_prev, st.e_cum, st.e_max, st.e_min))
+            st.e_prev = 0.0
+            if st.kind == "breakable":
+                st.damage = st.e_cum / st.fracture_energy
+                self._record({"kind": "damage", "iter": O.iter, "time": O.time, "id": bid,
+                              "radius": st.radius, "mass": st.mass,
+                              "specific_energy": st.event_max / st.mass, "e_cum": st.e_cum,
+                              "fracture_energy": before, "ratio": ratio})
+        elif st.kind == "breakable":
             after = float(model.weakened_fracture_energy(before, ratio, self.material[st.material].gamma))
             st.fracture_energy = after
             st.damage = 1.0 - after / st.fracture_energy_initial
@@ -522,8 +594,12 @@ class Breakage:
             if bid not in self.tracked:
                 continue
             mat = self.material[st.material]
-            ratio = ek / (st.mass * st.fracture_energy)
-            t10 = float(model.t10(ratio, mat.A, mat.b_prime, mat.kappa))
+            if mat.is_ab_t10:
+                ratio = st.e_cum / st.fracture_energy
+                t10 = float(mat.t10_of_cumulative_energy(st.e_cum, 2.0 * st.radius))
+            else:
+                ratio = ek / (st.mass * st.fracture_energy)
+                t10 = float(model.t10(ratio, mat.A, mat.b_prime, mat.kappa))
             if st.kind == "unbreakable":
                 st.t10 = t10                       # keeps the t10' of its first would-be breakage
                 del self.tracked[bid]
@@ -536,6 +612,8 @@ class Breakage:
                      "radius": st.radius, "mass": st.mass, "specific_energy": ek / st.mass,
                      "fracture_energy": st.fracture_energy, "ratio": ratio, "t10": t10,
                      "generation": st.generation, "fragments": []}
+            if mat.is_ab_t10:
+                event["e_cum"] = st.e_cum
             del self.tracked[bid]
             st.kind = "broken"
             if self.options.replace:
@@ -614,6 +692,13 @@ class Breakage:
             for k, e in zip(need, energies):
                 fs = self.bodies[ids[k]]
                 fs.fracture_energy = fs.fracture_energy_initial = float(e)
+            if mat.is_ab_t10:
+                for k, e_min in zip(need, mat.min_energy(2.0 * radii[need]).tolist()):
+                    self.bodies[ids[k]].e_min = e_min
+        pause = self.pause_steps[st.material]
+        if pause:
+            for nid in ids:
+                self.bodies[nid].pause_until = O.iter + pause
         for nid in ids:
             self._adopt(O.bodies[nid], self.bodies[nid])
         # zero the artificial overlaps: between siblings entirely; with each neighbour of the
@@ -908,7 +993,11 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     event_log (a JSON-lines path), read_period (1: contacts read every step; an integer k; or
     "auto": every k steps with k dt <= read_fraction (0.05) of the Rayleigh time of the smallest
     breakable body, so contacts of bodies that can break are sampled as finely as the paper's
-    5 % time step while dt follows the finest fragment).
+    5 % time step while dt follows the finest fragment), pause_steps (steps after its creation
+    during which a fragment counts no energy: Rocky's safeguard; default 25 for Ab-T10 materials,
+    0 for Tavares ones), fragments_energy_factor (1; multiplies the specific energy fragments see).
+    Each material file chooses its criterion (breakage.model = "tavares" or "ab_t10"); one scene
+    may mix both.
     """
     unknown = set(options) - set(Options.__dataclass_fields__) - {"seed"}
     if unknown:
@@ -995,6 +1084,12 @@ def _check_options(opts):
                                            and not isinstance(opts.read_period, bool)
                                            and opts.read_period >= 1)):
         problems.append(f"read_period = {opts.read_period!r}: accepted an integer >= 1 or 'auto'")
+    if opts.pause_steps is not None and not (isinstance(opts.pause_steps, int)
+                                             and not isinstance(opts.pause_steps, bool)
+                                             and opts.pause_steps >= 0):
+        problems.append(f"pause_steps = {opts.pause_steps!r}: accepted an integer >= 0 or None")
+    if not (0.0 < opts.fragments_energy_factor <= 1.0):
+        problems.append(f"fragments_energy_factor = {opts.fragments_energy_factor}: accepted (0, 1]")
     if not (0.0 < opts.read_fraction <= 1.0):
         problems.append(f"read_fraction = {opts.read_fraction}: accepted (0, 1]")
     if problems:

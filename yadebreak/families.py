@@ -342,8 +342,9 @@ def family_table(beta_params, t10_min, t10_max, seed=0):
 
 
 def table_for(material, seed=0):
-    """The FamilyTable of a breakable Material, from Eq. 9's t10' up to A."""
-    return family_table(material.beta_params, material.t10_min, material.A, seed)
+    """The FamilyTable of a breakable Material: t10' from Material.t10_min (Eq. 9 for Tavares)
+    up to Material.t10_ceiling (A, or Ab-T10's M)."""
+    return family_table(material.beta_params, material.t10_min, material.t10_ceiling, seed)
 
 
 def draw(rng, t10, beta_params=model.TABLE1_BETA_PARAMS, t10_min=None, t10_max=None, seed=0):

@@ -68,6 +68,15 @@ class Material:
     device_stiffness: float = model.DEVICE_STIFFNESS_STEEL
     beta_params: Mapping[float, tuple] | None = None
     beta_source: str | None = None
+    # Ab-T10 parameters (MODEL.md Section 9; None unless breakage_model == "ab_t10")
+    e_min_ref: float | None = None       # J/kg, at size_ref
+    size_ref: float | None = None        # m
+    selection: float | None = None       # S, kg/J
+    t10_max: float | None = None         # M, %
+
+    @property
+    def is_ab_t10(self):
+        return self.breakage_model == "ab_t10"
 
     # -- stiffness ---------------------------------------------------------------------------
     @property
@@ -85,44 +94,84 @@ class Material:
             raise ValueError(f"material '{self.name}' is not breakable: it has no {what}")
 
     def median_fracture_energy(self, size):
-        """Eq. 3: E50 (J/kg) at particle size `size` (m), against this material's device stiffness."""
+        """Eq. 3: E50 (J/kg) at particle size `size` (m), against this material's device stiffness.
+        Ab-T10: the e_cum at which half the particles of that size break (Eq. 9.3 at u = 0.5)."""
         self._need_breakable("fracture energy")
+        if self.is_ab_t10:
+            return self.fracture_energy_ppf(0.5, size)
         return model.median_fracture_energy(size, self.e_inf, self.d0, self.phi,
                                             self.hertz_stiffness, self.device_stiffness)
 
+    def min_energy(self, size):
+        """Ab-T10, Eq. 9.1: e_min (J/kg) at size `size` (m)."""
+        self._need_breakable("e_min")
+        return model.ab_t10_min_energy(size, self.e_min_ref, self.size_ref)
+
     def fracture_energy_cdf(self, energy, size):
-        """Eqs. 1-3: probability that a particle of size `size` (m) has fracture energy below `energy`."""
+        """Probability that a particle of size `size` (m) has its fracture energy below `energy`:
+        Eqs. 1-3 (Tavares); Eq. 9.3 (Ab-T10, where the fracture energy is the e_cum at which the
+        particle breaks)."""
+        if self.is_ab_t10:
+            return model.ab_t10_probability(energy, size, self.min_energy(size), self.selection,
+                                            self.size_ref)
         return model.fracture_energy_cdf(energy, self.median_fracture_energy(size), self.sigma,
                                          self.emax_ratio)
 
     def fracture_energy_ppf(self, u, size):
-        """Eqs. 1-3 inverted: the fracture energy (J/kg) at probability u for size `size` (m)."""
+        """The fracture energy (J/kg) at probability u for size `size` (m): Eqs. 1-3 inverted
+        (Tavares); the e_cum threshold of strength u (Ab-T10, Eq. 9.3 inverted)."""
+        if self.is_ab_t10:
+            return model.ab_t10_threshold(u, size, self.min_energy(size), self.selection,
+                                          self.size_ref)
         return model.fracture_energy_ppf(u, self.median_fracture_energy(size), self.sigma,
                                          self.emax_ratio)
 
     def sample_fracture_energy(self, rng, size):
-        """Eqs. 1-3: one fracture energy (J/kg) per size in `size` (m), from Generator `rng`."""
+        """One fracture energy (J/kg) per size in `size` (m), from Generator `rng`: Eqs. 1-3
+        (Tavares); for Ab-T10 the e_cum threshold of a strength drawn uniform in [0, 1)."""
         size = np.asarray(size, dtype=float)
+        if self.is_ab_t10:
+            return self.fracture_energy_ppf(rng.random(size.shape), size)
         return model.sample_fracture_energy(rng, self.median_fracture_energy(size), self.sigma,
                                             self.emax_ratio, size=size.shape)
 
     def breakage_probability(self, specific_energy, size, partner=None):
         """Probability that a fresh particle of size `size` (m) breaks when a contact brings it
         `specific_energy` = Ek/mp (J/kg), of which it absorbs e (Eq. 4) against `partner`
-        (a Material; None means the energy given is already Ek'/mp)."""
+        (a Material; None means the energy given is already Ek'/mp).
+        Ab-T10: P(e_cum) of the e_cum one such loading leaves (Eqs. 9.2-9.3, small steps)."""
         share = 1.0 if partner is None else self.energy_partition(partner)
-        return self.fracture_energy_cdf(share * np.asarray(specific_energy, dtype=float), size)
+        absorbed = share * np.asarray(specific_energy, dtype=float)
+        if self.is_ab_t10:
+            absorbed = model.ab_t10_single_impact_cum(absorbed, self.min_energy(size))
+        return self.fracture_energy_cdf(absorbed, size)
 
     def t10(self, ratio):
-        """Eq. 8 with this material's A, b' and kappa; ratio = Ek' / (mp E)."""
+        """Eq. 8 with this material's A, b' and kappa; ratio = Ek' / (mp E). Tavares only."""
         self._need_breakable("t10")
+        if self.is_ab_t10:
+            raise ValueError(f"material '{self.name}' uses Ab-T10: its t10 comes from e_cum "
+                             "(t10_of_cumulative_energy), not from Eq. 8")
         return model.t10(ratio, self.A, self.b_prime, self.kappa)
+
+    def t10_of_cumulative_energy(self, e_cum, size):
+        """Ab-T10, Eq. 9.4: t10 (%) of a particle of size `size` (m) broken at e_cum (J/kg)."""
+        return model.ab_t10_t10(e_cum, size, self.min_energy(size), self.selection,
+                                self.size_ref, self.t10_max)
 
     @property
     def t10_min(self):
-        """Eq. 9: t10' (%) of primary breakage."""
+        """The smallest t10' (%) a breakage gives: Eq. 9 (Tavares). Ab-T10's t10 = M P(e_cum)
+        has no floor; below AB_T10_T10_FLOOR % events take the family set of that floor."""
         self._need_breakable("t10")
+        if self.is_ab_t10:
+            return min(AB_T10_T10_FLOOR, 0.5 * self.t10_max)
         return float(model.t10_primary(self.A, self.b_prime, self.kappa))
+
+    @property
+    def t10_ceiling(self):
+        """The largest t10' (%): A (Tavares, Eq. 8) or M (Ab-T10, Eq. 9.4)."""
+        return self.t10_max if self.is_ab_t10 else self.A
 
     def contact_with(self, other):
         """Contact parameters (Table 6) for the pair (self, other).
@@ -162,6 +211,16 @@ _TAVARES = [
     ("kappa", 0.0, False, math.inf, False, "-", 1.0),
 ]
 _TAVARES_DEFAULTS = {"emax_ratio": 100.0, "kappa": 1.0}
+_AB_T10 = [
+    ("e_min_ref", 0.0, True, math.inf, False, "J/kg", 1.0),
+    ("size_ref", 0.0, False, math.inf, False, "mm", 1e-3),
+    ("selection", 0.0, False, math.inf, False, "kg/J", 1.0),
+    ("t10_max", 0.0, False, 100.0, True, "%", 1.0),
+]
+_MODELS = {"tavares": _TAVARES, "ab_t10": _AB_T10}
+#: Ab-T10 events with t10 below this (%) take the family set at this t10 (see Material.t10_min):
+#: below it the 11 classes cannot follow Eq. 10 within 2 % (2.6 % at t10 = 1 %).
+AB_T10_T10_FLOOR = 2.0
 _CONTACT = [
     ("friction", 0.0, True, 10.0, True, "-", 1.0),
     ("rolling_friction", 0.0, True, 10.0, True, "-", 1.0),
@@ -264,17 +323,23 @@ def _parse(doc, source):
     beta_source = None
     if breakable:
         model_name = breakage.get("model", "tavares")
-        if model_name != "tavares":
-            problems.append(f"breakage.model = {model_name!r}: accepted 'tavares'")
-        allowed = {k[0] for k in _TAVARES} | {"model", "device_stiffness", "beta", "beta_source"}
+        if model_name not in _MODELS:
+            problems.append(f"breakage.model = {model_name!r}: accepted 'tavares' (the default) "
+                            "or 'ab_t10'")
+            model_name = "tavares"
+        fields = _MODELS[model_name]
+        allowed = {k[0] for k in fields} | {"model", "beta", "beta_source"}
+        if model_name == "tavares":
+            allowed.add("device_stiffness")
         _check_keys(breakage, allowed, "breakage", problems)
-        for key, lo, lo_inc, hi, hi_inc, unit, factor in _TAVARES:
+        for key, lo, lo_inc, hi, hi_inc, unit, factor in fields:
             v = _number(breakage, key, "breakage", problems, lo, lo_inc, hi, hi_inc, unit,
-                        default=_TAVARES_DEFAULTS.get(key))
+                        default=_TAVARES_DEFAULTS.get(key) if model_name == "tavares" else None)
             values[key] = None if v is None else v * factor
-        dev = _number(breakage, "device_stiffness", "breakage", problems, 0.0, False, 1500.0,
-                      True, "GPa", required=False, default=model.DEVICE_STIFFNESS_STEEL / 1e9)
-        values["device_stiffness"] = None if dev is None else dev * 1e9
+        if model_name == "tavares":
+            dev = _number(breakage, "device_stiffness", "breakage", problems, 0.0, False, 1500.0,
+                          True, "GPa", required=False, default=model.DEVICE_STIFFNESS_STEEL / 1e9)
+            values["device_stiffness"] = None if dev is None else dev * 1e9
         beta_source = breakage.get("beta_source", "material")
         if beta_source not in ("material", "table1"):
             problems.append(f"breakage.beta_source = {beta_source!r}: accepted 'material' (the "

@@ -27,6 +27,13 @@ def breakage_result(brk, ids, material, size, specific_energy, partner):
     result = {"specific_energy": specific_energy, "particles": n,
               "broken_fraction": len(broken) / n, "model_probability": p_model,
               "binomial_sigma": float(np.sqrt(p_model * (1 - p_model) / n))}
+    if material.is_ab_t10:
+        # the e_cum the intact particles carry: what the broken ones would have reached
+        broken_ids = {e["id"] for e in broken}
+        e_cum = [brk.bodies[i].e_cum for i in ids if i not in broken_ids and i in brk.bodies]
+        if e_cum:
+            result["e_cum_measured"] = float(np.mean(e_cum))
+            result["p_of_e_cum_measured"] = float(material.fracture_energy_cdf(np.mean(e_cum), size))
     if broken:
         parent_mass = sum(e["mass"] for e in broken)
         sieves = size * np.geomspace(1e-3, 0.99, 40)    # below the feed size: progeny only
@@ -53,19 +60,26 @@ def plot_breakage(results, material, size, partner, title, path, label="simulati
     energies = [r["specific_energy"] for r in results]
     grid = np.geomspace(min(energies) / 3, max(energies) * 3, 200)
     axes[0].semilogx(grid, 100 * material.breakage_probability(grid, size, partner=partner), "k-",
-                     label="model (Eqs. 1-4)")
+                     label=("model P(e_cum), e_cum = e Ek/mp - e_min (Eqs. 4, 9.1-9.3)"
+                            if material.is_ab_t10 else "model (Eqs. 1-4)"))
+    measured = [(r["specific_energy"], r["p_of_e_cum_measured"]) for r in results
+                if "p_of_e_cum_measured" in r]
+    if measured:
+        axes[0].plot(*zip(*[(e, 100 * p) for e, p in measured]), "kx", ms=8,
+                     label="P(e_cum) at the e_cum measured")
     axes[0].errorbar(energies, [100 * r["broken_fraction"] for r in results],
                      yerr=[300 * r["binomial_sigma"] for r in results], fmt="o", c="C3",
                      label=f"{label} (3 sigma)")
     axes[0].set(xlabel="specific energy Ek/mp (J/kg)", ylabel="broken (%)", title=title)
-    axes[0].legend()
+    axes[0].legend(loc="upper left", fontsize=8)
     for k, r in enumerate(results):
         if "relative_sizes" in r:
             axes[1].semilogx(r["relative_sizes"], r["progeny_passing_model"], "-", c=f"C{k}",
                              label=f"model, {r['specific_energy']:g} J/kg")
             axes[1].semilogx(r["relative_sizes"], r["progeny_passing_simulated"], "o", ms=4,
                              c=f"C{k}", label=f"simulation, t10 {r['t10_simulated']:.1f} % "
-                                              f"(Eq. 8: {r['t10_model_eq8']:.1f} %)")
+                                              f"({'Eq. 9.4' if material.is_ab_t10 else 'Eq. 8'}: "
+                                              f"{r['t10_model_eq8']:.1f} %)")
     axes[1].set(xlabel="relative size d / d_parent", ylabel="progeny passing (%)",
                 title="progeny of broken particles (fines included)")
     axes[1].legend(fontsize=7)
