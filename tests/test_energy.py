@@ -68,11 +68,11 @@ def test_subcritical_impact_weakens_by_eqs_5_6(scene):
     assert brk.body_state(ids[0])["fracture_energy"] == st.fracture_energy
 
 
-def _events_for(seed, steps_before=None, tmp_path=None):
+def _events_for(seed, steps_before=None, tmp_path=None, material="limestone"):
     from yade import O
     from yadebreak import coupling, scenes
     speeds = list(np.linspace(3, 30, 24))
-    brk, ids = scenes.impact_scene("limestone", 5.5e-3, speeds=speeds, seed=seed, replace=False)
+    brk, ids = scenes.impact_scene(material, 5.5e-3, speeds=speeds, seed=seed, replace=False)
     if steps_before is not None:
         O.run(steps_before, True)
         path = str(tmp_path / "mid.yade.gz")
@@ -86,14 +86,15 @@ def _events_for(seed, steps_before=None, tmp_path=None):
              round(e["fracture_energy"], 9)) for e in brk.events]
 
 
-def test_same_seed_same_events_and_save_load_continues(scene, tmp_path):
-    first = _events_for(7)
-    again = _events_for(7)
-    other = _events_for(8)
+@pytest.mark.parametrize("material", ["limestone", "ab_t10_ore"])
+def test_same_seed_same_events_and_save_load_continues(scene, tmp_path, material):
+    first = _events_for(7, material=material)
+    again = _events_for(7, material=material)
+    other = _events_for(8, material=material)
     assert first == again
     assert first != other
     assert any(k == "breakage" for k, *_ in first) and any(k == "damage" for k, *_ in first)
-    resumed = _events_for(7, steps_before=310, tmp_path=tmp_path)
+    resumed = _events_for(7, steps_before=310, tmp_path=tmp_path, material=material)
     assert resumed == first
 
 
