@@ -2,6 +2,8 @@
 on a steel anvil; breakage probability, t10 and the progeny size distribution against the model.
 
     yade -n -x scripts/drop_weight.py --material copper_ore --energies 150,600
+
+An interrupted run continues with --resume 1, keeping the energies it finished (out/partial.json).
 """
 import json
 import sys
@@ -12,21 +14,26 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 
 
 from yadebreak import load_material, reports  # noqa: E402
-from yadebreak.scriptargs import progress, script_params  # noqa: E402
+from yadebreak.scriptargs import PartialResults, progress, script_params  # noqa: E402
 
 args = script_params(dict(material="copper_ore", size=5.5e-3, particles=60, seed=1,
                           energies="150,600", striker_mass_ratio=50.0, time_step_fraction=0.05,
-                          max_time=0.003, out="out/drop_weight"), __doc__)
+                          max_time=0.003, out="out/drop_weight", resume=False,
+                          stop_after=0), __doc__)
 
 from yade import O  # noqa: E402
-from yadebreak import scenes  # noqa: E402
+from yadebreak import coupling, scenes  # noqa: E402
 
 mat, steel = load_material(args.material), load_material("steel")
 out = Path(args.out)
 out.mkdir(parents=True, exist_ok=True)
 results = []
 start = time.time()
+partial = PartialResults(out, args)
 for k, energy in enumerate(float(e) for e in args.energies.split(",")):
+    if partial.get(energy) is not None:
+        results.append(partial.get(energy))
+        continue
     brk, ids, strikers = scenes.drop_weight_scene(
         args.material, args.size, energy, args.particles, args.striker_mass_ratio,
         seed=args.seed + k, time_step_fraction=args.time_step_fraction,
@@ -34,11 +41,14 @@ for k, energy in enumerate(float(e) for e in args.energies.split(",")):
     initial_mass = brk.total_mass()
     # until every striker rebounds (or max_time of simulated time); then open events close
     while any(O.bodies[s].state.vel[2] < 0 for s in strikers) and O.time < args.max_time:
-        O.run(500, True)
+        coupling.run_steps(500)
     brk.finish()
     result = reports.breakage_result(brk, ids, mat, args.size, energy, steel)
     result["mass_relative_error"] = abs(brk.total_mass() - initial_mass) / initial_mass
     results.append(result)
+    partial.add(energy, result)
+    if args.stop_after and len(partial.done) >= args.stop_after:
+        sys.exit(0)                          # as if killed here (tests)
     progress(f"{energy:g} J/kg: {100 * result['broken_fraction']:.1f} % broken (model "
              f"{100 * result['model_probability']:.1f} %), {time.time() - start:.1f} s")
 

@@ -6,6 +6,9 @@ Ab-T10 e_cum of Eq. 9.2) into the next impact. Default: 37.5 mm copper ore at 94
 
     yade -n -x scripts/repeated_impact.py --gamma 3
     yade -n -x scripts/repeated_impact.py --material ab_t10_ore --size 5.5e-3 --energy 180 --impacts 8
+
+The scene is checkpointed after every impact (out/checkpoint.yade.gz); an interrupted run continues
+with --resume 1 exactly as if it had not stopped.
 """
 import dataclasses
 import json
@@ -22,10 +25,11 @@ from yadebreak.scriptargs import progress, script_params  # noqa: E402
 
 args = script_params(dict(material="copper_ore", size=37.5e-3, particles=100, impacts=20,
                           energy=94.7, gamma=0.0, seed=1, target="steel",
-                          time_step_fraction=0.05, out="out/repeated_impact"), __doc__)
+                          time_step_fraction=0.05, out="out/repeated_impact", resume=False,
+                          stop_after=0), __doc__)
 
 from yade import O  # noqa: E402
-from yadebreak import scenes  # noqa: E402
+from yadebreak import coupling, scenes  # noqa: E402
 
 mat = load_material(args.material)
 if args.gamma > 0:
@@ -37,14 +41,24 @@ speed = float(np.sqrt(2 * args.energy))
 out = Path(args.out)
 out.mkdir(parents=True, exist_ok=True)
 start = time.time()
-brk, ids = scenes.impact_scene(mat, args.size, [speed] * args.particles, target=args.target,
-                               seed=args.seed, replace=False,
-                               time_step_fraction=args.time_step_fraction,
-                               event_log=str(out / "events.jsonl"))
-home = {i: tuple(O.bodies[i].state.pos) for i in ids}
-alive = list(ids)
-fractions = []
-for k in range(args.impacts):
+checkpoint = out / "checkpoint.yade.gz"
+if args.resume:
+    brk, loop = coupling.load_checkpoint(checkpoint)
+    if loop["arguments"] != repr(sorted((k, v) for k, v in vars(args).items()
+                                        if k not in ("resume", "stop_after"))):
+        sys.exit(f"--resume: {checkpoint} was written with other arguments; run without --resume")
+    ids, alive, fractions = loop["ids"], loop["alive"], loop["fractions"]
+    home = {int(i): tuple(p) for i, p in loop["home"].items()}
+    progress(f"resumed from {checkpoint} after impact {len(fractions)}")
+else:
+    brk, ids = scenes.impact_scene(mat, args.size, [speed] * args.particles, target=args.target,
+                                   seed=args.seed, replace=False,
+                                   time_step_fraction=args.time_step_fraction,
+                                   event_log=str(out / "events.jsonl"))
+    home = {i: tuple(O.bodies[i].state.pos) for i in ids}
+    alive = list(ids)
+    fractions = []
+for k in range(len(fractions), args.impacts):
     for i in alive:                          # back above the plate, same speed, no spin
         b = O.bodies[i]
         b.state.pos = home[i]
@@ -57,6 +71,12 @@ for k in range(args.impacts):
     alive = [i for i in alive if i not in broken]
     fractions.append(1 - len(alive) / args.particles)
     progress(f"impact {k + 1}: {100 * fractions[-1]:.0f} % broken, {time.time() - start:.1f} s")
+    coupling.save_checkpoint(checkpoint, {
+        "ids": ids, "alive": alive, "fractions": fractions, "home": home,
+        "arguments": repr(sorted((k, v) for k, v in vars(args).items()
+                                 if k not in ("resume", "stop_after")))})
+    if args.stop_after and len(fractions) >= args.stop_after:
+        sys.exit(0)                          # as if killed here (tests)
 
 if mat.is_ab_t10:
     model_fractions = model.ab_t10_repeated_broken_fraction(

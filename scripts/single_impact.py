@@ -4,6 +4,10 @@ The paper's Figs. 8-10 and 13-16: N particles of one material and size fired nor
 at each specific energy Ek/mp = v^2/2. Writes summary.json and single_impact.png into --out.
 
     yade -n -x scripts/single_impact.py --material copper_ore --energies 100,200,400
+    yade -n -x scripts/single_impact.py --material ab_t10_ore --energies 250,400,800 --particles 100
+
+Each energy is one scene with its own seed (--seed + its index); an interrupted run continues with
+--resume 1, keeping the energies it finished (out/partial.json).
 """
 import json
 import sys
@@ -15,11 +19,12 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 import numpy as np  # noqa: E402
 
 from yadebreak import load_material, reports  # noqa: E402
-from yadebreak.scriptargs import progress, script_params  # noqa: E402
+from yadebreak.scriptargs import PartialResults, progress, script_params  # noqa: E402
 
 args = script_params(dict(material="copper_ore", size=5.5e-3, particles=250, seed=1,
                           target="steel", energies="100,200,400", replace=True,
-                          time_step_fraction=0.05, out="out/single_impact"), __doc__)
+                          time_step_fraction=0.05, out="out/single_impact", resume=False,
+                          stop_after=0), __doc__)
 
 from yadebreak import scenes  # noqa: E402
 
@@ -29,7 +34,11 @@ out = Path(args.out)
 out.mkdir(parents=True, exist_ok=True)
 results = []
 start = time.time()
+partial = PartialResults(out, args)
 for k, energy in enumerate(float(e) for e in args.energies.split(",")):
+    if partial.get(energy) is not None:
+        results.append(partial.get(energy))
+        continue
     speed = float(np.sqrt(2 * energy))
     brk, ids = scenes.impact_scene(args.material, args.size, [speed] * args.particles,
                                    target=args.target, seed=args.seed + k, replace=args.replace,
@@ -45,6 +54,9 @@ for k, energy in enumerate(float(e) for e in args.energies.split(",")):
                                                          for e in intact])) if intact else None),
         "mass_relative_error": abs(brk.total_mass() - initial_mass) / initial_mass})
     results.append(result)
+    partial.add(energy, result)
+    if args.stop_after and len(partial.done) >= args.stop_after:
+        sys.exit(0)                          # as if killed here (tests)
     progress(f"{energy:g} J/kg: {100 * result['broken_fraction']:.1f} % broken (model "
              f"{100 * result['model_probability']:.1f} %), {steps} steps, "
              f"{time.time() - start:.1f} s")

@@ -15,7 +15,6 @@ from .scriptargs import progress
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
 TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
-_LOOP_TAG = "yadebreak_bed"
 
 
 def _fates(brk, particles):
@@ -64,24 +63,17 @@ def write_vtk(path, brk):
 
 
 def _checkpoint(path, info, loop):
-    """O.save the scene (yadebreak's state travels in O.tags) with the loop's own state."""
-    O.tags[_LOOP_TAG] = json.dumps({
+    """The scene with the loop's own state (see coupling.save_checkpoint)."""
+    coupling.save_checkpoint(path, {
         "loop": loop, "info": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
                                for k, v in info.items() if k != "material"}})
-    tmp = path.with_name(path.name + ".tmp.yade.gz")
-    O.save(str(tmp))
-    tmp.replace(path)
 
 
 def _resume(path):
-    if not path.exists():
-        raise SystemExit(f"--resume: no checkpoint at {path}; run without --resume first "
-                         "(checkpoints are written every --checkpoint-every seconds)")
-    O.load(str(path))
-    data = json.loads(O.tags[_LOOP_TAG])
+    brk, data = coupling.load_checkpoint(path)
     info = data["info"]
     info["centers"] = np.array(info["centers"])
-    return coupling._controller("yadebreak"), info, data["loop"]
+    return brk, info, data["loop"]
 
 
 def run(args, quiet=False):
@@ -116,7 +108,7 @@ def run(args, quiet=False):
     stop_after = getattr(args, "stop_after", 0.0)
     last_report = last_checkpoint = start
     while True:
-        O.run(100 if loop["touched"] is None else 400, True)
+        coupling.run_steps(100 if loop["touched"] is None else 400)
         if loop["touched"] is None and any(O.interactions.withBody(info["ball"])):
             loop["touched"] = O.time
             scenes.hold_release(info)

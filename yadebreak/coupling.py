@@ -619,7 +619,8 @@ class Breakage:
             if self.options.replace:
                 direction = (np.array([0.0, 0.0, 1.0]) if strongest is None
                              else strongest[2] * np.array(strongest[1]))
-                event["fragments"], event["family_t10"] = self._replace(bid, st, t10, direction)
+                (event["fragments"], event["family_t10"],
+                 event["fragment_speed_excess"]) = self._replace(bid, st, t10, direction)
             self._record(event)
         self._lower_time_step(self._pending_dt)
         self.wall_time["replace"] += time.perf_counter() - t0
@@ -637,6 +638,10 @@ class Breakage:
         vel = placement.fragment_velocities(centers, masses, center, np.array(body.state.vel),
                                             np.array(body.state.angVel))
         angvel = body.state.angVel
+        # no fragment may leave faster than the parent's rigid field allows: |v| + 2 |w| r bounds
+        # it (v + w x (c_i - c_cm) after the momentum shift); the event records the margin
+        speed_excess = float(np.linalg.norm(vel, axis=1).max() - np.linalg.norm(body.state.vel)
+                             - 2.0 * np.linalg.norm(angvel) * radius)
         material = body.material
         mat = self.material[st.material]
         dmin = opts.dmin if opts.dmin is not None else self.top_size / 20.0
@@ -720,7 +725,7 @@ class Breakage:
                 self._pending_dt = min(self._pending_dt, opts.time_step_fraction * tr)
             else:
                 self._check_time_step(tr)
-        return new_ids, fam.t10
+        return new_ids, fam.t10, speed_excess
 
     def _zero_new(self, ids, centers, radii, ii, jj, overlap, neighbours):
         """Zero the artificial overlaps of fresh fragments (see _replace)."""
@@ -951,6 +956,38 @@ def _controller(label):
         ctl = Breakage.from_tags(label)
         _REGISTRY[label] = ctl
     return ctl
+
+
+_SCRIPT_TAG = "yadebreak_script"
+
+
+def save_checkpoint(path, script_state):
+    """O.save the scene to `path` (yadebreak's own state travels in O.tags) with a script's loop
+    state (a JSON-able dict), written to a temporary file first so a crash never leaves half a
+    checkpoint."""
+    path = Path(path)
+    O.tags[_SCRIPT_TAG] = json.dumps(script_state)
+    tmp = path.with_name(path.name + ".tmp.yade.gz")
+    O.save(str(tmp))
+    os.replace(tmp, path)
+
+
+def load_checkpoint(path, label="yadebreak"):
+    """O.load a checkpoint written by save_checkpoint; returns (controller, script state)."""
+    path = Path(path)
+    if not path.exists():
+        raise SystemExit(f"--resume: no checkpoint at {path}; run without --resume first")
+    O.load(str(path))
+    return _controller(label), json.loads(O.tags[_SCRIPT_TAG])
+
+
+def run_steps(steps):
+    """Advance the scene by `steps` steps now and return. O.run(n, True) waits for the run in 40 ms
+    polls (measured: 40 ms for 1 to 500 steps of a small scene, 120 ms for 5000 that take 71 ms),
+    so short runs in a loop (a run to rebound, a progress loop) step directly."""
+    step = O.step
+    for _ in range(int(steps)):
+        step()
 
 
 def _run(label):

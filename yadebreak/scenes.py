@@ -6,7 +6,7 @@ import math
 import numpy as np
 
 # the coupling makes yade importable from Debian's python3 first
-from .coupling import O, _wrapper as _w, add_materials, attach, utils
+from .coupling import O, _wrapper as _w, add_materials, attach, run_steps, utils
 
 
 def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False):
@@ -54,7 +54,7 @@ def run_until_rebound(ids, max_steps=200000, check_every=50):
     touches nothing, or max_steps."""
     done_steps = 0
     while done_steps < max_steps:
-        O.run(check_every, True)
+        run_steps(check_every)
         done_steps += check_every
         if all(_left(i) for i in ids):
             break

@@ -38,3 +38,43 @@ def script_params(defaults, description=None, argv=None):
 def progress(message):
     """One line of progress, flushed at once (long runs print these)."""
     print(f"[yadebreak] {message}", flush=True)
+
+
+class PartialResults:
+    """Results a script has finished, kept in <out>/partial.json as it goes, so that `--resume 1`
+    skips what an interrupted run completed. Each unit of work (an energy) must depend only on the
+    arguments and its own seed, so that resuming gives what an uninterrupted run gives.
+
+        partial = PartialResults(out, args)          # args.resume decides
+        for energy in energies:
+            result = partial.get(energy) or compute(energy)
+            partial.add(energy, result)
+    """
+
+    def __init__(self, out, args):
+        import json
+        from pathlib import Path
+        self.path = Path(out) / "partial.json"
+        self.arguments = {k: v for k, v in sorted(vars(args).items())
+                          if k not in ("resume", "out", "stop_after")}
+        self.done = {}
+        if getattr(args, "resume", False) and self.path.exists():
+            data = json.loads(self.path.read_text())
+            if data["arguments"] != self.arguments:
+                changed = sorted(k for k in set(data["arguments"]) | set(self.arguments)
+                                 if data["arguments"].get(k) != self.arguments.get(k))
+                raise SystemExit(f"--resume: {self.path} was written with other values of "
+                                 f"{changed}; run again without --resume or with the same values")
+            self.done = data["done"]
+            progress(f"resuming: {len(self.done)} finished unit(s) kept from {self.path}")
+
+    def get(self, key):
+        return self.done.get(str(key))
+
+    def add(self, key, result):
+        import json
+        import os
+        self.done[str(key)] = result
+        tmp = self.path.with_suffix(".tmp")
+        tmp.write_text(json.dumps({"arguments": self.arguments, "done": self.done}))
+        os.replace(tmp, self.path)
