@@ -3,8 +3,9 @@
     /usr/bin/python3 benchmarks/bench_engine.py [--quick]
 
 1. Per step, with breakage out of reach (fracture energies set very high): plain YADE, the floor of
-   a no-op PyRunner at every step, yadebreak reading every contact every step (exact) and with
-   read_period="auto", on the default bed (37 particles, 3.05 J) and on a 5-layer, 4-ring bed.
+   a no-op PyRunner at every step, yadebreak reading every contact every step (exact), with
+   read_period="auto" and with read_period="fast", on the default bed (37 particles, 3.05 J) and
+   on a 5-layer, 4-ring bed.
 2. Per breakage event: the package's own work for a family drawn at t10' = 10 % in scenes of
    1e3, 1e4 and 3e4 bodies, YADE's extra work on the next step, and yade.bf.replaceSphere
    (YADE's own, 27 sub-spheres) on the same scenes.
@@ -30,7 +31,7 @@ STEPS = 5000 if QUICK else 20000
 def bed_rate(rings, layers, mode):
     """Microseconds per step during the impact, breakage out of reach."""
     coupling._REGISTRY.clear()
-    options = {} if mode in ("plain", "noop") else {"read_period": 1 if mode == "exact" else "auto"}
+    options = {} if mode in ("plain", "noop") else {"read_period": 1 if mode == "exact" else mode}
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, rings, layers, 3.05, seed=1,
                                         **options)
     for st in brk.bodies.values():
@@ -55,13 +56,13 @@ def per_step_table():
     for rings, layers, label in ((3, 1, "default bed (37 particles)"),
                                  (4, 5, "5 layers x 4 rings")):
         rates = {}
-        for mode in ("plain", "noop", "exact", "auto"):
+        for mode in ("plain", "noop", "exact", "auto", "fast"):
             rates[mode], contacts = bed_rate(rings, layers, mode)
         plain, floor = rates["plain"], rates["noop"]
         print(f"  {label}: {contacts} contacts")
         print(f"    plain YADE            {plain:8.1f} us/step")
         print(f"    + no-op PyRunner      {floor:8.1f} us/step  ({floor / plain:.2f} x plain)")
-        for mode in ("exact", "auto"):
+        for mode in ("exact", "auto", "fast"):
             own = rates[mode] - floor
             print(f"    yadebreak {mode:5s}       {rates[mode]:8.1f} us/step  "
                   f"({rates[mode] / plain:.2f} x plain; own work beyond the floor "

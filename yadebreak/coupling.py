@@ -90,6 +90,12 @@ def add_materials(labels, stiffness_scale=1.0):
     return ip2, mats
 
 
+#: Slots of a contact record saved in O.tags (the geom and phys wrappers after them are not).
+_SAVED_SLOTS = 13
+
+#: read_period="fast" never waits longer than this many steps between reads.
+FAST_MAX_PERIOD = 200
+
 #: Rocky's pause after a breakage event, in steps (seed 002, Section 2.4.2).
 AB_T10_PAUSE_STEPS = 25
 
@@ -137,9 +143,12 @@ class Options:
     time_step_fraction: float | None = 0.05
     event_log: str | None = None
     seed: int = 0
-    read_period: int | str = 1      # 1: every step (exact); k; or "auto" (see _auto_period)
+    read_period: int | str = 1      # 1: every step (exact); k; "auto" (see _auto_period) or
+                                    # "fast" (see _fast_period)
     read_fraction: float = 0.05     # "auto": read at this fraction of the Rayleigh time of the
                                     # smallest breakable body
+    fast_fraction: float = 0.25     # "fast": reads per Hertz loading time, at least 1 / this
+    fast_tolerance: float = 0.02    # "fast": largest rise between reads, as a fraction of E
     family_seed: int = 0
     zero_overlaps: bool = True      # False only to show what the zeroing prevents
     dummies: str = "spheres"        # "spheres" (the paper) or "ledger" (fines kept outside the DEM)
@@ -176,7 +185,11 @@ class Breakage:
         self._log = None
         self._breakable_radii = []                 # heap of (radius, id), lazily cleaned
         self._auto_key = None
-        self.period = 1 if options.read_period == "auto" else options.read_period
+        self._speed_max = None                     # "fast": largest body speed, last scan
+        self._reads_since_scan = 0
+        self._load_key = None
+        self._load_time_1 = 0.0
+        self.period = 1 if options.read_period in ("auto", "fast") else options.read_period
 
     # -- set-up -------------------------------------------------------------------------------
     def _resolve_materials(self):
@@ -384,6 +397,8 @@ class Breakage:
         cs = opts.cs
         tracked = self.tracked
         contacts = self.contacts
+        zeroed = self.zeroed
+        now_time = O.time
         stiff = self.stiffness_by_id
         seen = {}
         energy = {}               # body -> Ek' (counted)
@@ -406,27 +421,60 @@ class Breakage:
                     continue
                 ka = stiff[bodies[a].material.id]
                 kb = stiff[bodies[b].material.id]
-                # [delta, force, En, offset_a, offset_b, e_a, e_b, us, Fs, Es, geom, phys]
+                # [delta, force, En, offset_a, offset_b, e_a, e_b, us, Fs, Es,
+                #  delta and time of the read before, time of the last read, geom, phys]
                 # (the last two: wrappers kept while the contact lives, never saved)
                 c = [0.0, 0.0, 0.0, 0.0, 0.0,
                      float(model.energy_partition(ka, kb)), float(model.energy_partition(kb, ka)),
-                     0.0, 0.0, 0.0, g, i.phys]
+                     0.0, 0.0, 0.0, 0.0, now_time, now_time, g, i.phys]
                 contacts[key] = c
-            elif len(c) == 10:                     # restored from O.tags: wrappers again
+            elif len(c) == _SAVED_SLOTS:           # restored from O.tags: wrappers again
                 c += [i.geom, i.phys]
-            g = c[10]
+            g = c[13]
             delta = g.penetrationDepth
-            force = c[11].normalForce.norm()      # compressive while the overlap grows
+            force = c[14].normalForce.norm()      # compressive while the overlap grows
+            if delta < c[0] and c[10] < c[0] and c[12] > c[11]:
+                # the overlap peaked between the last two reads: add the Hertz energy from the
+                # last read up to the peak of the parabola through the last three overlaps
+                # (matters when reads are sparse: read_period > 1 or "fast")
+                peak = model.parabolic_peak(c[11], c[10], c[12], c[0], now_time, delta)
+                if peak > c[0] and not (zeroed and ((a, b) in zeroed or (b, a) in zeroed)):
+                    kno = c[14].kno
+                    el0 = kno * c[0] * math.sqrt(c[0])
+                    c[2] += (0.4 * kno * (peak ** 2.5 - c[0] ** 2.5)
+                             + 0.5 * (c[1] - el0) * (peak - c[0]))
+                    if ta is not None:
+                        grew.add(a)
+                    if tb is not None:
+                        grew.add(b)
             if delta > c[0]:
-                c[2] += 0.5 * (c[1] + force) * (delta - c[0])
+                d0 = c[0]
+                if zeroed and ((a, b) in zeroed or (b, a) in zeroed):
+                    c[2] += 0.5 * (c[1] + force) * (delta - d0)     # kno varies: trapezoid
+                else:
+                    # Hertz part exact (Eq. 14 with F = kno delta^1.5), whatever the read
+                    # interval; only the dashpot part by the trapezoidal rule
+                    kno = c[14].kno
+                    el0 = kno * d0 * math.sqrt(d0)
+                    el1 = kno * delta * math.sqrt(delta)
+                    if d0 > 0.0:
+                        c[2] += (0.4 * (el1 * delta - el0 * d0)
+                                 + 0.5 * (c[1] - el0 + force - el1) * (delta - d0))
+                    else:
+                        # from first touch the dashpot force grows like delta^(1/4) (Mindlin's
+                        # cn ~ kn^(1/2) ~ delta^(1/4), rate nearly constant): 1/1.25 of F delta
+                        c[2] += 0.4 * el1 * delta + 0.8 * (force - el1) * delta
                 if ta is not None:
                     grew.add(a)
                 if tb is not None:
                     grew.add(b)
+            c[10] = c[0]
+            c[11] = c[12]
+            c[12] = now_time
             c[0] = delta
             c[1] = force
             if cs > 0.0:
-                ph = c[11]
+                ph = c[14]
                 us = ph.usTotal.norm()
                 fs = ph.shearForce.norm()
                 if us > c[7]:
@@ -461,6 +509,9 @@ class Breakage:
         factor = opts.fragments_energy_factor
         ab_labels = self.ab_t10_labels
         ab_bodies = []
+        fast = opts.read_period == "fast"
+        limits = []               # "fast": steps each loaded body allows before the next read
+        interval = max(1, now - self.last_iter)
         for bid in list(open_events.union(energy)):
             st = tracked.get(bid)
             if st is None:
@@ -481,6 +532,9 @@ class Breakage:
             if st.material in ab_labels:
                 ab_bodies.append((bid, st, ek, specific))
                 continue
+            if fast and specific > st.specific_energy:
+                limits.append(self._steps_allowed(st.fracture_energy, specific,
+                                                  specific - st.specific_energy, interval))
             if specific > st.fracture_energy:
                 if specific - st.specific_energy > 0.8 * st.fracture_energy and st.specific_energy > 0:
                     self._warn_jump(bid, specific - st.specific_energy, st.fracture_energy)
@@ -495,6 +549,9 @@ class Breakage:
                 [x[1].e_cum for x in ab_bodies], [x[1].e_max for x in ab_bodies],
                 [x[1].e_min for x in ab_bodies])
             for (bid, st, ek, specific), cum, top in zip(ab_bodies, e_cum.tolist(), e_max.tolist()):
+                if fast and specific > st.e_prev:
+                    limits.append(self._steps_allowed(st.fracture_energy, cum,
+                                                      specific - st.e_prev, interval))
                 rise = cum - st.e_cum
                 st.e_cum, st.e_max, st.e_prev = cum, top, specific
                 if cum > st.fracture_energy:
@@ -510,6 +567,49 @@ class Breakage:
         self.last_iter = O.iter
         if self.options.read_period == "auto":
             self._auto_period()
+        elif fast:
+            self._fast_period(limits)
+
+    def _steps_allowed(self, threshold, level, rise, interval):
+        """"fast": steps until the next read for a body whose criterion variable is `level` below
+        `threshold` (J/kg) and rose by `rise` over the last `interval` steps: half the way to
+        the threshold, or fast_tolerance of it, at the present rate."""
+        return (max(self.options.fast_tolerance * threshold, 0.5 * (threshold - level))
+                * interval / rise)
+
+    def _fast_period(self, limits):
+        """read_period="fast": read again after k steps, k the smallest of
+        - what every loaded body allows (_steps_allowed), so that no body's energy passes its
+          fracture energy by more than fast_tolerance of it between reads;
+        - fast_fraction of the Hertz loading time of the smallest breakable sphere at twice the
+          largest speed in the scene (rescanned every 16 reads and after breakage), so that an
+          impact that begins between reads is read several times while it loads;
+        - FAST_MAX_PERIOD steps."""
+        heap = self._breakable_radii
+        while heap and getattr(self.tracked.get(heap[0][1]), "kind", None) != "breakable":
+            heapq.heappop(heap)
+        if not heap:
+            k = FAST_MAX_PERIOD
+        else:
+            self._reads_since_scan += 1
+            if self._reads_since_scan >= 16 or self._speed_max is None:
+                self._reads_since_scan = 0
+                self._speed_max = max((b.state.vel.norm() for b in O.bodies
+                                       if b is not None and b.dynamic), default=0.0)
+            radius, bid = heap[0]
+            if self._load_key != (radius, bid):
+                mat = O.bodies[bid].material
+                self._load_key = (radius, bid)
+                self._load_time_1 = float(placement.hertz_loading_time(
+                    radius, mat.density, mat.young, mat.poisson, 1.0))   # at 1 m/s; ~ v^-1/5
+            load_time = self._load_time_1 * max(2.0 * self._speed_max, 1e-6) ** -0.2
+            k = min(FAST_MAX_PERIOD, int(self.options.fast_fraction * load_time / O.dt))
+        if limits:
+            k = min(k, int(min(limits)))
+        k = max(1, k)
+        if k != self.period:
+            self.period = k
+            _find_engine(self.label).iterPeriod = k
 
     def _follow_event(self, bid, st, ek, specific, grew, touching):
         """Keep a stressing event open while its energy grows; close it once the body unloads."""
@@ -554,7 +654,7 @@ class Breakage:
         total = 0.0
         for c, slot in touching:
             if c[2] + cs * c[9] - c[slot] >= emin and c[0] > 0.0:
-                total += c[5 if slot == 3 else 6] * 0.4 * c[11].kno * c[0] ** 2.5
+                total += c[5 if slot == 3 else 6] * 0.4 * c[14].kno * c[0] ** 2.5
         return total
 
     def _close_event(self, bid, st, touching):
@@ -590,6 +690,7 @@ class Breakage:
     def _break_all(self, broken, contacts):
         t0 = time.perf_counter()
         self._pending_dt = math.inf
+        self._speed_max = None                    # "fast": fragments may be the fastest now
         for bid, st, ek, strongest in broken:
             if bid not in self.tracked:
                 continue
@@ -885,7 +986,7 @@ class Breakage:
                 "rng": self.rng.bit_generator.state, "iter": O.iter, "top_size": self.top_size,
                 "bodies": {str(k): v.as_dict() for k, v in self.bodies.items()},
                 "tracked": sorted(self.tracked),
-                "contacts": [[k[0], k[1], c[:10]] for k, c in self.contacts.items()],
+                "contacts": [[k[0], k[1], c[:_SAVED_SLOTS]] for k, c in self.contacts.items()],
                 "zeroed": [[k[0], k[1], z] for k, z in self.zeroed.items()],
                 "damped_until": self.damped_until, "events": self.events, "ledger": self.ledger,
                 "warned": sorted(self.warned)}
@@ -1082,7 +1183,8 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
         Path(opts.event_log).parent.mkdir(parents=True, exist_ok=True)
         open(opts.event_log, "w").close()
     runner = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run({label!r})",
-                               iterPeriod=1 if opts.read_period == "auto" else opts.read_period,
+                               iterPeriod=(1 if opts.read_period in ("auto", "fast")
+                                           else opts.read_period),
                                initRun=True, label=label)
     zero = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run_zero({label!r})",
                              iterPeriod=1, initRun=True, label=label + "_zero", dead=True)
@@ -1117,10 +1219,15 @@ def _check_options(opts):
         problems.append(f"time_step_fraction = {opts.time_step_fraction}: accepted (0, 1]")
     if opts.dummies not in ("spheres", "ledger"):
         problems.append(f"dummies = {opts.dummies!r}: accepted 'spheres' or 'ledger'")
-    if not (opts.read_period == "auto" or (isinstance(opts.read_period, int)
-                                           and not isinstance(opts.read_period, bool)
-                                           and opts.read_period >= 1)):
-        problems.append(f"read_period = {opts.read_period!r}: accepted an integer >= 1 or 'auto'")
+    if not (opts.read_period in ("auto", "fast") or (isinstance(opts.read_period, int)
+                                                     and not isinstance(opts.read_period, bool)
+                                                     and opts.read_period >= 1)):
+        problems.append(f"read_period = {opts.read_period!r}: accepted an integer >= 1, 'auto' "
+                        "or 'fast'")
+    if not (0.0 < opts.fast_fraction <= 1.0):
+        problems.append(f"fast_fraction = {opts.fast_fraction}: accepted (0, 1]")
+    if not (0.0 < opts.fast_tolerance <= 1.0):
+        problems.append(f"fast_tolerance = {opts.fast_tolerance}: accepted (0, 1]")
     if opts.pause_steps is not None and not (isinstance(opts.pause_steps, int)
                                              and not isinstance(opts.pause_steps, bool)
                                              and opts.pause_steps >= 0):

@@ -169,6 +169,26 @@ def weakened_fracture_energy(energy, ratio, gamma):
     return np.asarray(energy, dtype=float) * (1.0 - damage(ratio, gamma))
 
 
+def parabolic_peak(t0, x0, t1, x1, t2, x2):
+    """Largest value of the parabola through (t0, x0), (t1, x1), (t2, x2), t0 < t1 < t2: the peak
+    overlap between reads of a contact that grew, then shrank (Eq. 14's integral up to the peak).
+    Falls back to x1 when the three points are not concave or the vertex lies outside [t0, t2].
+    Plain floats: called once per contact and impact."""
+    h0, h1 = t1 - t0, t2 - t1
+    if h0 <= 0.0 or h1 <= 0.0:
+        return x1
+    s0, s1 = (x1 - x0) / h0, (x2 - x1) / h1
+    curvature = (s1 - s0) / (h0 + h1)            # half the second derivative
+    if curvature >= 0.0:
+        return x1
+    # x(t) = x1 + b (t - t1) + curvature (t - t1)^2, b the centred slope at t1
+    b = s0 + curvature * h0
+    t_peak = -b / (2.0 * curvature)
+    if not -h0 <= t_peak <= h1:
+        return x1
+    return x1 + b * t_peak + curvature * t_peak * t_peak
+
+
 # --------------------------------------------------------------------------- Eqs. 7-9
 def t10(ratio, A, b_prime, kappa=1.0):
     """Eq. 8: t10' (%) of one particle broken at ratio = Ek' / (mp E) (E its own fracture energy).

@@ -112,3 +112,14 @@ def rayleigh_time(radius, density, young, poisson):
     shear_modulus = np.asarray(young, dtype=float) / (2.0 * (1.0 + np.asarray(poisson, dtype=float)))
     return np.pi * np.asarray(radius, dtype=float) * np.sqrt(density / shear_modulus) / (
         0.1631 * np.asarray(poisson, dtype=float) + 0.8766)
+
+
+def hertz_loading_time(radius, density, young, poisson, speed):
+    """Duration (s) of the loading half of a Hertz impact of a sphere on a rigid wall at `speed`
+    (m/s): t_c / 2, t_c = 2.868 (m^2 / (R E*^2 v))^(1/5), E* = Y / (1 - nu^2). The shortest
+    loading a sphere of this size can see at that closing speed (a softer partner lengthens it)."""
+    radius = np.asarray(radius, dtype=float)
+    mass = density * 4.0 / 3.0 * np.pi * radius ** 3
+    e_star = np.asarray(young, dtype=float) / (1.0 - np.asarray(poisson, dtype=float) ** 2)
+    speed = np.maximum(np.asarray(speed, dtype=float), 1e-12)
+    return 0.5 * 2.868 * (mass ** 2 / (radius * e_star ** 2 * speed)) ** 0.2
