@@ -24,12 +24,23 @@ from yadebreak import coupling, scenes  # noqa: E402
 from yadebreak.coupling import O, _wrapper, utils  # noqa: E402
 
 QUICK = "--quick" in sys.argv
-# O.run(n, True) polls for the end, which quantises one run's time to ~40 ms: many steps
-STEPS = 5000 if QUICK else 20000
+# O.run(n, True) waits in 40 ms polls, so steps are timed with coupling.run_steps (O.step in a
+# loop, the same for every mode); the window is the ball's loading of the bed
+STEPS = 3000 if QUICK else 8000
+REPEATS = 1 if QUICK else 3
 
 
 def bed_rate(rings, layers, mode):
-    """Microseconds per step during the impact, breakage out of reach."""
+    """Microseconds per step during the impact (the best of REPEATS runs), breakage out of
+    reach, and the share of that time yadebreak spent reading contacts."""
+    best = None
+    for _ in range(REPEATS):
+        rate = _bed_rate_once(rings, layers, mode)
+        best = rate if best is None or rate[0] < best[0] else best
+    return best
+
+
+def _bed_rate_once(rings, layers, mode):
     coupling._REGISTRY.clear()
     options = {} if mode in ("plain", "noop") else {"read_period": 1 if mode == "exact" else mode}
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, rings, layers, 3.05, seed=1,
@@ -43,21 +54,24 @@ def bed_rate(rings, layers, mode):
             engines.insert(3, _wrapper.PyRunner(command="pass", iterPeriod=1))
         O.engines = engines
     while not any(O.interactions.withBody(info["ball"])):       # to the first touch
-        O.run(50, True)
+        coupling.run_steps(50)
     scenes.hold_release(info)
+    read_before = brk.wall_time["read"]
     start = time.perf_counter()
-    O.run(STEPS, True)
+    coupling.run_steps(STEPS)
+    elapsed = time.perf_counter() - start
     contacts = O.interactions.countReal()
-    return 1e6 * (time.perf_counter() - start) / STEPS, contacts
+    read_share = (brk.wall_time["read"] - read_before) / elapsed
+    return 1e6 * elapsed / STEPS, contacts, read_share
 
 
 def per_step_table():
     print("\n1. Cost per step during the impact (breakage out of reach)")
     for rings, layers, label in ((3, 1, "default bed (37 particles)"),
                                  (4, 5, "5 layers x 4 rings")):
-        rates = {}
+        rates, shares = {}, {}
         for mode in ("plain", "noop", "exact", "auto", "fast"):
-            rates[mode], contacts = bed_rate(rings, layers, mode)
+            rates[mode], contacts, shares[mode] = bed_rate(rings, layers, mode)
         plain, floor = rates["plain"], rates["noop"]
         print(f"  {label}: {contacts} contacts")
         print(f"    plain YADE            {plain:8.1f} us/step")
@@ -66,7 +80,8 @@ def per_step_table():
             own = rates[mode] - floor
             print(f"    yadebreak {mode:5s}       {rates[mode]:8.1f} us/step  "
                   f"({rates[mode] / plain:.2f} x plain; own work beyond the floor "
-                  f"{own:.1f} us = {own / plain:.2f} x YADE's step)")
+                  f"{own:.1f} us = {own / plain:.2f} x YADE's step; reading contacts "
+                  f"{100 * shares[mode]:.0f} % of the time)")
 
 
 def cloud(n, dummies="spheres"):

@@ -69,14 +69,14 @@ def bed_run(tsf, read, dummies, dmin_ratio):
 
 
 singles = [(0.01, 1.0, 1), (0.02, 1.0, 1), (0.05, 1.0, 1), (0.1, 1.0, 1), (0.2, 1.0, 1),
-           (0.05, 0.1, 1), (0.05, 0.01, 1), (0.05, 1.0, "auto")]
+           (0.05, 0.1, 1), (0.05, 0.01, 1), (0.05, 1.0, "auto"), (0.05, 1.0, "fast")]
 # the bed's reference is the paper's setting (5 % of the Rayleigh time, every contact read, dummy
 # spheres): finer time steps take hours here
-beds = [(0.05, 1, "spheres", 20), (0.05, "auto", "spheres", 20), (0.05, 1, "ledger", 20),
-        (0.05, "auto", "ledger", 20), (0.1, "auto", "ledger", 20), (0.05, "auto", "ledger", 5),
-        (0.05, "auto", "ledger", 40)]
+beds = [(0.05, 1, "spheres", 20), (0.05, "auto", "spheres", 20), (0.05, "fast", "spheres", 20),
+        (0.05, 1, "ledger", 20), (0.05, "auto", "ledger", 20), (0.05, "fast", "ledger", 20),
+        (0.1, "auto", "ledger", 20), (0.05, "auto", "ledger", 5), (0.05, "auto", "ledger", 40)]
 if args.quick:
-    singles, beds = singles[:1] + singles[2:4] + singles[-1:], beds[3:5]
+    singles, beds = singles[:1] + singles[2:4] + singles[-2:], beds[4:7]
 for setting in singles:
     rows.append(single(*setting))
     print(f"[yadebreak] single impact {setting}: {rows[-1]['wall_s']:.1f} s", flush=True)

@@ -81,7 +81,8 @@ def run(args, quiet=False):
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     energy = args.energy if args.speed <= 0 else 0.5 * scenes.BALL_MASS * args.speed ** 2
-    read_period = args.read_period if args.read_period == "auto" else int(args.read_period)
+    read_period = (args.read_period if args.read_period in ("auto", "fast")
+                   else int(args.read_period))
     options = dict(time_step_fraction=args.time_step_fraction, dummies=args.dummies,
                    read_period=read_period, event_log=str(out / "events.jsonl"))
     if args.dmin > 0:
