@@ -59,16 +59,7 @@ else:
     alive = list(ids)
     fractions = []
 for k in range(len(fractions), args.impacts):
-    for i in alive:                          # back above the plate, same speed, no spin
-        b = O.bodies[i]
-        b.state.pos = home[i]
-        b.state.vel = (0.0, 0.0, -speed)
-        b.state.angVel = (0.0, 0.0, 0.0)
-    scenes.run_until_rebound(alive)
-    broken = {e["id"] for e in brk.breakage_events}
-    for i in [i for i in alive if i in broken]:
-        O.bodies.erase(i)                    # a broken particle leaves the test
-    alive = [i for i in alive if i not in broken]
+    alive = scenes.impact_again(brk, alive, home, speed)   # broken particles leave the test
     fractions.append(1 - len(alive) / args.particles)
     progress(f"impact {k + 1}: {100 * fractions[-1]:.0f} % broken, {time.time() - start:.1f} s")
     coupling.save_checkpoint(checkpoint, {

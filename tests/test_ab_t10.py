@@ -184,14 +184,7 @@ def test_repeated_impacts_accumulate_and_follow_the_closed_form(scene):
     home = {i: tuple(O.bodies[i].state.pos) for i in ids}
     alive, got = list(ids), []
     for _ in range(impacts):
-        for i in alive:
-            O.bodies[i].state.pos, O.bodies[i].state.vel = home[i], (0, 0, -speed)
-            O.bodies[i].state.angVel = (0, 0, 0)
-        scenes.run_until_rebound(alive)
-        broken = {e["id"] for e in brk.breakage_events}
-        for i in [i for i in alive if i in broken]:
-            O.bodies.erase(i)
-        alive = [i for i in alive if i not in broken]
+        alive = scenes.impact_again(brk, alive, home, speed)
         got.append(1 - len(alive) / n)
     absorbed = AB.energy_partition(STEEL) * energy
     expected = model.ab_t10_repeated_broken_fraction(absorbed, SIZE, AB.min_energy(SIZE),

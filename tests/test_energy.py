@@ -152,15 +152,7 @@ def test_repeated_impacts_follow_the_damage_model(scene):
     alive = list(ids)
     got = []
     for _ in range(impacts):
-        for i in alive:
-            O.bodies[i].state.pos = home[i]
-            O.bodies[i].state.vel = (0, 0, -speed)
-            O.bodies[i].state.angVel = (0, 0, 0)
-        scenes.run_until_rebound(alive)
-        broken = {e["id"] for e in brk.breakage_events}
-        for i in [i for i in alive if i in broken]:
-            O.bodies.erase(i)
-        alive = [i for i in alive if i not in broken]
+        alive = scenes.impact_again(brk, alive, home, speed)
         got.append(1 - len(alive) / n)
     share = mat.energy_partition(load_material("steel"))
     expected = model.repeated_impact_broken_fraction(

@@ -61,6 +61,23 @@ def run_until_rebound(ids, max_steps=200000, check_every=50):
     return done_steps
 
 
+def impact_again(brk, alive, home, speed):
+    """One more impact (paper Fig. 11): the particles `alive` go back to `home` (id -> position)
+    and are fired at `speed` normally at the plate, without spin; run to rebound. The ones that
+    broke leave the test (erased). Returns the ids still alive."""
+    for i in alive:
+        state = O.bodies[i].state
+        state.pos = home[i]
+        state.vel = (0.0, 0.0, -speed)
+        state.angVel = (0.0, 0.0, 0.0)
+    run_until_rebound(alive)
+    broken = {e["id"] for e in brk.breakage_events}
+    for i in alive:
+        if i in broken:
+            O.bodies.erase(i)
+    return [i for i in alive if i not in broken]
+
+
 def _left(i):
     b = O.bodies[i] if i < len(O.bodies) else None
     if b is None:
