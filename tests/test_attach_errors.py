@@ -88,3 +88,28 @@ def test_time_step_too_large_warns_with_the_remedy(scene):
     with pytest.warns(RuntimeWarning, match=r"O.dt = 1e-06 s is 28 % of the Rayleigh time.*time_step_fraction"):
         coupling.attach({"ore": "copper_ore"}, time_step_fraction=None)
     assert O.dt == 1e-6             # the user's time step is left alone
+
+
+@pytest.mark.parametrize("read_period, fraction, remedy", [(1, 0.4, "time_step_fraction"),
+                                                         (8, 0.05, "read_period"),
+                                                         (1, 0.05, None)])
+def test_energy_jumping_past_the_fracture_energy_warns_once_with_the_remedy(
+        scene, recwarn, read_period, fraction, remedy):
+    """A 60 m/s impact (1800 J/kg) on particles whose fracture energy is 100 J/kg, read every 8
+    steps or with a time step at 40 % of the Rayleigh time: the energy passes E by far in one read,
+    and the warning names the knob that fixes it, once; read every step at 5 %, no warning."""
+    from yadebreak import scenes
+    brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [60.0, 60.0], read_period=read_period,
+                                   time_step_fraction=fraction, replace=False)
+    for i in ids:
+        brk.bodies[i].fracture_energy = 100.0
+    scenes.run_until_rebound(ids)
+    jumps = [w for w in recwarn.list if "between two reads" in str(w.message)]
+    assert len(brk.breakage_events) == 2
+    if remedy is None:
+        assert not jumps
+        return
+    assert len(jumps) == 1
+    message = str(jumps[0].message)
+    assert "of the fracture energy" in message and f"reduce {remedy}" in message
+    assert f"read every {read_period} step(s)" in message

@@ -536,7 +536,7 @@ class Breakage:
                 limits.append(self._steps_allowed(st.fracture_energy, specific,
                                                   specific - st.specific_energy, interval))
             if specific > st.fracture_energy:
-                if specific - st.specific_energy > 0.8 * st.fracture_energy and st.specific_energy > 0:
+                if specific - st.specific_energy > 0.8 * st.fracture_energy:
                     self._warn_jump(bid, specific - st.specific_energy, st.fracture_energy)
                 st.specific_energy = specific
                 broken.append((bid, st, ek, strongest.get(bid)))
@@ -622,10 +622,14 @@ class Breakage:
             self._close_event(bid, st, touching.get(bid, ()))
 
     def _warn_jump(self, bid, rise, scale):
+        mode = self.options.read_period
+        remedy = ("time_step_fraction" if self.period == 1 else
+                  "fast_fraction" if mode == "fast" else
+                  "read_fraction" if mode == "auto" else "read_period")
         self._warn_once("jump", (
             f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
             f"two reads at body {bid} (read every {self.period} step(s) of {O.dt:.3g} s): reduce "
-            "time_step_fraction (or read_fraction / read_period) for an accurate t10'"))
+            f"{remedy} for an accurate t10'"))
 
     def _auto_period(self):
         """Read every k steps, k dt <= read_fraction T_R of the smallest breakable body."""
