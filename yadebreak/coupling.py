@@ -770,15 +770,24 @@ class Breakage:
         radii, centers, masses, vel = radii[inserted], centers[inserted], masses[inserted], vel[inserted]
         is_dummy = fam.is_dummy[inserted]
         new_bodies = []
-        for k in range(len(radii)):
-            b = utils.sphere(tuple(centers[k]), float(radii[k]), material=material)
-            b.state.mass = float(masses[k])
-            inertia = 0.4 * float(masses[k]) * float(radii[k]) ** 2
-            b.state.inertia = (inertia, inertia, inertia)
-            b.state.vel = tuple(vel[k])
-            b.state.angVel = angvel
-            if opts.global_damping > 0.0:
-                b.state.isDamped = True        # global damping acts on fresh fragments only
+        damped = opts.global_damping > 0.0
+        for center_k, radius_k, mass_k, vel_k in zip(centers.tolist(), radii.tolist(),
+                                                      masses.tolist(), vel.tolist()):
+            # built directly (11 us) rather than with utils.sphere (36 us), which would also
+            # compute a mass and inertia we replace and pick a random colour
+            b = _wrapper.Body()
+            b.shape = _wrapper.Sphere(radius=radius_k)
+            b.material = material
+            b.bound = _wrapper.Aabb()
+            state = b.state
+            state.pos = state.refPos = center_k
+            state.mass = mass_k
+            inertia = 0.4 * mass_k * radius_k * radius_k
+            state.inertia = (inertia, inertia, inertia)
+            state.vel = vel_k
+            state.angVel = angvel
+            if damped:
+                state.isDamped = True          # global damping acts on fresh fragments only
             new_bodies.append(b)
         ids = O.bodies.append(new_bodies)
         new_ids = list(ids)
