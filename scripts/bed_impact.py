@@ -18,7 +18,7 @@ from yadebreak.scriptargs import script_params  # noqa: E402
 
 args = script_params(dict(material="copper_ore", size=5.5e-3, rings=3, layers=1, energy=3.05,
                           speed=0.0, seed=1, time_step_fraction=0.05, dmin=0.0,
-                          global_damping=0.0, dummies="ledger", read_period="auto", max_time=0.02,
+                          global_damping=0.0, dummies="ledger", read_period="fast", max_time=0.02,
                           checkpoint_every=60.0, resume=False, out="out/bed_impact"), __doc__)
 
 from yadebreak import bed  # noqa: E402

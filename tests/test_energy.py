@@ -68,11 +68,12 @@ def test_subcritical_impact_weakens_by_eqs_5_6(scene):
     assert brk.body_state(ids[0])["fracture_energy"] == st.fracture_energy
 
 
-def _events_for(seed, steps_before=None, tmp_path=None, material="limestone"):
+def _events_for(seed, steps_before=None, tmp_path=None, material="limestone", read_period=1):
     from yade import O
     from yadebreak import coupling, scenes
     speeds = list(np.linspace(3, 30, 24))
-    brk, ids = scenes.impact_scene(material, 5.5e-3, speeds=speeds, seed=seed, replace=False)
+    brk, ids = scenes.impact_scene(material, 5.5e-3, speeds=speeds, seed=seed, replace=False,
+                                   read_period=read_period)
     if steps_before is not None:
         O.run(steps_before, True)
         path = str(tmp_path / "mid.yade.gz")
@@ -86,15 +87,17 @@ def _events_for(seed, steps_before=None, tmp_path=None, material="limestone"):
              round(e["fracture_energy"], 9)) for e in brk.events]
 
 
-@pytest.mark.parametrize("material", ["limestone", "ab_t10_ore"])
-def test_same_seed_same_events_and_save_load_continues(scene, tmp_path, material):
-    first = _events_for(7, material=material)
-    again = _events_for(7, material=material)
-    other = _events_for(8, material=material)
+@pytest.mark.parametrize("material, read_period", [("limestone", 1), ("ab_t10_ore", 1),
+                                                   ("limestone", "fast")])
+def test_same_seed_same_events_and_save_load_continues(scene, tmp_path, material, read_period):
+    first = _events_for(7, material=material, read_period=read_period)
+    again = _events_for(7, material=material, read_period=read_period)
+    other = _events_for(8, material=material, read_period=read_period)
     assert first == again
     assert first != other
     assert any(k == "breakage" for k, *_ in first) and any(k == "damage" for k, *_ in first)
-    resumed = _events_for(7, steps_before=310, tmp_path=tmp_path, material=material)
+    resumed = _events_for(7, steps_before=310, tmp_path=tmp_path, material=material,
+                          read_period=read_period)
     assert resumed == first
 
 

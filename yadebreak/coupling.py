@@ -1002,7 +1002,8 @@ class Breakage:
                 "contacts": [[k[0], k[1], c[:_SAVED_SLOTS]] for k, c in self.contacts.items()],
                 "zeroed": [[k[0], k[1], z] for k, z in self.zeroed.items()],
                 "damped_until": self.damped_until, "events": self.events, "ledger": self.ledger,
-                "warned": sorted(self.warned)}
+                "warned": sorted(self.warned),
+                "fast": [self._speed_max, self._reads_since_scan]}
 
     def sync_tags(self):
         """Write the whole state into O.tags, so that O.save keeps it (done by O.save itself)."""
@@ -1032,6 +1033,7 @@ class Breakage:
         self.events = data["events"]
         self.ledger = data["ledger"]
         self.warned = set(data["warned"])
+        self._speed_max, self._reads_since_scan = data.get("fast", [None, 0])
         self.last_iter = data["iter"] - 1
         for bid, st in self.bodies.items():
             b = O.bodies[bid] if bid < len(O.bodies) else None
