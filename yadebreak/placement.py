@@ -45,29 +45,36 @@ def place_fragments(center, radius, fragment_radii, load_direction, rng):
         angle = phase + 2.0 * np.pi * j / len(coarse)
         reach = radius - radii[i]
         out[i] = center + reach * (np.cos(angle) * u + np.sin(angle) * w)
-    placed_c = [out[i] for i in coarse]
-    placed_r = [radii[i] for i in coarse]
-    for i in order[len(coarse):]:
-        reach = max(radius - radii[i], 0.0)
-        # random points in the ball of radius `reach`, the first one on the loaded side
-        dirs = rng.normal(size=(_CANDIDATES, 3))
-        dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
-        dist = reach * rng.random(_CANDIDATES) ** (1.0 / 3.0)
-        cand = center + dirs * dist[:, None]
-        cand[0] = center + n * reach * rng.random()
-        if placed_c:
-            pc = np.array(placed_c)
-            pr = np.array(placed_r)
-            gap = np.linalg.norm(cand[:, None, :] - pc[None, :, :], axis=2) - (pr[None, :] + radii[i])
-            overlap = np.clip(-gap, 0.0, None).sum(axis=1)
-        else:
-            overlap = np.zeros(_CANDIDATES)
-        toward_load = (cand - center) @ n
-        score = overlap - 1e-3 * radius * toward_load / max(reach, 1e-300)
-        best = int(np.argmin(score))
-        out[i] = cand[best]
-        placed_c.append(out[i])
-        placed_r.append(radii[i])
+    fine = order[len(coarse):]
+    placed_c = np.empty((len(radii), 3))           # centres placed so far, in placing order
+    placed_r = np.empty(len(radii))
+    m = len(coarse)
+    placed_c[:m] = out[coarse] if m else placed_c[:0]
+    placed_r[:m] = radii[coarse]
+    if len(fine):
+        # every fine fragment's candidates at once: random points in the ball of radius `reach`,
+        # the first one on the loaded side (drawn fragment by fragment, in the order a loop would)
+        draws = [(rng.normal(size=(_CANDIDATES, 3)), rng.random(_CANDIDATES), rng.random())
+                 for _ in fine]
+        dirs = np.array([d[0] for d in draws])
+        dirs /= np.linalg.norm(dirs, axis=2, keepdims=True)
+        reach = np.maximum(radius - radii[fine], 0.0)
+        dist = reach[:, None] * np.array([d[1] for d in draws]) ** (1.0 / 3.0)
+        cand = center + dirs * dist[:, :, None]
+        cand[:, 0] = center + (n[None, :] * reach[:, None]) * np.array([d[2] for d in draws])[:, None]
+        scale = 1e-3 * radius
+        for f, i in enumerate(fine):
+            bias = scale * ((cand[f] - center) @ n) / max(reach[f], 1e-300)
+            if m:
+                diff = cand[f][:, None, :] - placed_c[None, :m, :]
+                gap = np.sqrt((diff * diff).sum(axis=2)) - (placed_r[None, :m] + radii[i])
+                score = np.maximum(-gap, 0.0).sum(axis=1) - bias
+            else:
+                score = -bias
+            out[i] = cand[f, int(np.argmin(score))]
+            placed_c[m] = out[i]
+            placed_r[m] = radii[i]
+            m += 1
     # guard against round-off pushing a centre a hair outside the parent
     offset = out - center
     dist = np.linalg.norm(offset, axis=1)
