@@ -68,14 +68,15 @@ def test_fast_wall_impacts_receive_e_m_v2_over_2_within_3_percent(scene):
 
 
 @pytest.mark.yade
-@pytest.mark.parametrize("energy", [200.0, 400.0])
-def test_fast_single_impacts_break_as_every_step_reading(scene, energy):
+@pytest.mark.parametrize("material, energy", [("copper_ore", 200.0), ("copper_ore", 400.0),
+                                              ("ab_t10_ore", 400.0)])
+def test_fast_single_impacts_break_as_every_step_reading(scene, material, energy):
     """Broken fraction within 3 points of every-step reading (the issue's 3 %), same particles."""
     from yadebreak import coupling, scenes
     got = {}
     for mode in (1, "fast"):
         coupling._REGISTRY.clear()
-        brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [math.sqrt(2 * energy)] * 250,
+        brk, ids = scenes.impact_scene(material, 5.5e-3, [math.sqrt(2 * energy)] * 250,
                                        seed=3, replace=False, read_period=mode)
         scenes.run_until_rebound(ids)
         got[mode] = len(brk.breakage_events) / 250
