@@ -144,8 +144,33 @@ def event_table():
               f"({np.median(times) / np.median(own):.0f} x yadebreak), refused {refused} of 5")
 
 
+def end_to_end():
+    """The default bed impact as `make demo` runs it (fast mode, ledger), and with every contact read
+    every step: wall time and its shares."""
+    import argparse
+    import tempfile
+    from yadebreak import bed
+    print("\n3. The default bed impact end to end (target 3 minutes), where the time goes")
+    for read, dummies in (("fast", "ledger"), (1, "spheres")):
+        coupling._REGISTRY.clear()
+        with tempfile.TemporaryDirectory() as out:
+            args = argparse.Namespace(material="copper_ore", size=5.5e-3, rings=3, layers=1,
+                                      energy=3.05, speed=0.0, seed=1, time_step_fraction=0.05,
+                                      dmin=0.0, global_damping=0.0, dummies=dummies,
+                                      read_period=read, max_time=0.004 if QUICK else 0.02,
+                                      checkpoint_every=-1, out=out)
+            _, s = bed.run(args, quiet=True)
+        total = s["runtime_s"]
+        read_s, replace_s = s["wall_time_read_s"], s["wall_time_replace_s"]
+        print(f"  read_period={read!s:4s} dummies={dummies:7s}: {total:6.1f} s ({180 / total:.1f}x under "
+              f"3 min), {s['breakage_events']} breakages, broken {100 * s['broken_mass_fraction']:.1f} %; "
+              f"reading contacts {100 * read_s / total:.0f} %, replacement {100 * replace_s / total:.0f} %, "
+              f"YADE and the rest {100 * (total - read_s - replace_s) / total:.0f} %")
+
+
 if __name__ == "__main__":
     per_step_table()
     event_table()
+    end_to_end()
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"\npeak memory {peak:.0f} MB")
