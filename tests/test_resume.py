@@ -22,6 +22,8 @@ def _script(name, out, *extra):
     ("repeated_impact", ["--material", "ab_t10_ore", "--size", "5.5e-3", "--energy", "180",
                          "--impacts", "4", "--particles", "30"]),
     ("single_impact", ["--material", "limestone", "--energies", "60,120", "--particles", "30"]),
+    ("drop_weight", ["--material", "limestone", "--energies", "60,120", "--particles", "6",
+                     "--max-time", "3e-4"]),
 ])
 def test_interrupted_script_resumes_to_the_same_result(tmp_path, name, arguments):
     _script(name, tmp_path / "whole", *arguments)
@@ -33,7 +35,7 @@ def test_interrupted_script_resumes_to_the_same_result(tmp_path, name, arguments
     cut = json.loads((tmp_path / "cut" / "summary.json").read_text())
     for d in (whole, cut):
         d.pop("runtime_s")
-    if name == "single_impact":
+    if name in ("single_impact", "drop_weight"):
         for d in (whole, cut):
             for r in d["results"]:
                 r.pop("steps_wall_s", None)
