@@ -399,7 +399,8 @@ class Breakage:
         contacts = self.contacts
         zeroed = self.zeroed
         now_time = O.time
-        first_touch = 0.8 - 0.3 / max(1, O.iter - self.last_iter) ** 2
+        interval = max(1, O.iter - self.last_iter)      # steps since the last read
+        first_touch = 0.8 - 0.3 / interval ** 2
         stiff = self.stiffness_by_id
         seen = {}
         energy = {}               # body -> Ek' (counted)
@@ -434,25 +435,15 @@ class Breakage:
             g = c[13]
             delta = g.penetrationDepth
             force = c[14].normalForce.norm()      # compressive while the overlap grows
-            if delta < c[0] and c[10] < c[0] and c[12] > c[11]:
-                # the overlap peaked between the last two reads: add the Hertz energy from the
-                # last read up to the peak of the parabola through the last three overlaps
-                # (matters when reads are sparse: read_period > 1 or "fast")
-                peak = model.parabolic_peak(c[11], c[10], c[12], c[0], now_time, delta)
-                if peak > c[0] and not (zeroed and ((a, b) in zeroed or (b, a) in zeroed)):
-                    kno = c[14].kno
-                    el0 = kno * c[0] * math.sqrt(c[0])
-                    c[2] += (0.4 * kno * (peak ** 2.5 - c[0] ** 2.5)
-                             + 0.5 * (c[1] - el0) * (peak - c[0]))
-                    if ta is not None:
-                        grew.add(a)
-                    if tb is not None:
-                        grew.add(b)
-            if delta > c[0]:
-                d0 = c[0]
-                if zeroed and ((a, b) in zeroed or (b, a) in zeroed):
-                    c[2] += 0.5 * (c[1] + force) * (delta - d0)     # kno varies: trapezoid
-                else:
+            d0 = c[0]
+            peaked = delta < d0 and c[10] < d0 and c[12] > c[11]
+            if delta > d0 or peaked:
+                # a zeroed pair's kno varies (zero_overlaps): the trapezoid on its total force
+                hertz = not (zeroed and ((a, b) in zeroed or (b, a) in zeroed))
+                worked = True
+                if delta > d0 and not hertz:
+                    c[2] += 0.5 * (c[1] + force) * (delta - d0)
+                elif delta > d0:
                     # Hertz part exact (Eq. 14 with F = kno delta^1.5), whatever the read
                     # interval; only the dashpot part by the trapezoidal rule
                     kno = c[14].kno
@@ -467,10 +458,23 @@ class Breakage:
                         # tends to 0.8 F delta; over one step YADE's leapfrog makes it the
                         # trapezoid's 0.5 F delta (measured: exact to 0.02 % at 5 % of T_R)
                         c[2] += 0.4 * el1 * delta + first_touch * (force - el1) * delta
-                if ta is not None:
-                    grew.add(a)
-                if tb is not None:
-                    grew.add(b)
+                else:
+                    # the overlap peaked between the last two reads: add the Hertz energy from
+                    # the last read up to the peak of the parabola through the last three
+                    # overlaps (matters when reads are sparse: read_period > 1 or "fast")
+                    peak = (model.parabolic_peak(c[11], c[10], c[12], d0, now_time, delta)
+                            if hertz else d0)
+                    worked = peak > d0
+                    if worked:
+                        kno = c[14].kno
+                        el0 = kno * d0 * math.sqrt(d0)
+                        c[2] += (0.4 * kno * (peak ** 2.5 - d0 ** 2.5)
+                                 + 0.5 * (c[1] - el0) * (peak - d0))
+                if worked:
+                    if ta is not None:
+                        grew.add(a)
+                    if tb is not None:
+                        grew.add(b)
             c[10] = c[0]
             c[11] = c[12]
             c[12] = now_time
@@ -514,7 +518,6 @@ class Breakage:
         ab_bodies = []
         fast = opts.read_period == "fast"
         limits = []               # "fast": steps each loaded body allows before the next read
-        interval = max(1, now - self.last_iter)
         for bid in list(open_events.union(energy)):
             st = tracked.get(bid)
             if st is None:
@@ -523,8 +526,7 @@ class Breakage:
             if st.pause_until > now:
                 # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
                 # did meanwhile is never counted later
-                for c, slot in touching.get(bid, ()):
-                    c[slot] = c[2] + cs * c[9]
+                self._restart_offsets(touching.get(bid, ()))
                 st.event_max = st.specific_energy = 0.0
                 open_events.discard(bid)
                 continue
@@ -588,10 +590,8 @@ class Breakage:
           largest speed in the scene (rescanned every 16 reads and after breakage), so that an
           impact that begins between reads is read several times while it loads;
         - FAST_MAX_PERIOD steps."""
-        heap = self._breakable_radii
-        while heap and getattr(self.tracked.get(heap[0][1]), "kind", None) != "breakable":
-            heapq.heappop(heap)
-        if not heap:
+        smallest = self._smallest_breakable()
+        if smallest is None:
             k = FAST_MAX_PERIOD
         else:
             self._reads_since_scan += 1
@@ -599,17 +599,27 @@ class Breakage:
                 self._reads_since_scan = 0
                 self._speed_max = max((b.state.vel.norm() for b in O.bodies
                                        if b is not None and b.dynamic), default=0.0)
-            radius, bid = heap[0]
-            if self._load_key != (radius, bid):
+            radius, bid = smallest
+            if self._load_key != smallest:
                 mat = O.bodies[bid].material
-                self._load_key = (radius, bid)
+                self._load_key = smallest
                 self._load_time_1 = float(placement.hertz_loading_time(
                     radius, mat.density, mat.young, mat.poisson, 1.0))   # at 1 m/s; ~ v^-1/5
             load_time = self._load_time_1 * max(2.0 * self._speed_max, 1e-6) ** -0.2
             k = min(FAST_MAX_PERIOD, int(self.options.fast_fraction * load_time / O.dt))
         if limits:
             k = min(k, int(min(limits)))
-        k = max(1, k)
+        self._set_period(max(1, k))
+
+    def _smallest_breakable(self):
+        """(radius, id) of the smallest breakable body, or None (broken ones dropped lazily)."""
+        heap = self._breakable_radii
+        while heap and getattr(self.tracked.get(heap[0][1]), "kind", None) != "breakable":
+            heapq.heappop(heap)
+        return heap[0] if heap else None
+
+    def _set_period(self, k):
+        """Read every k steps from now on."""
         if k != self.period:
             self.period = k
             _find_engine(self.label).iterPeriod = k
@@ -636,22 +646,18 @@ class Breakage:
 
     def _auto_period(self):
         """Read every k steps, k dt <= read_fraction T_R of the smallest breakable body."""
-        heap = self._breakable_radii
-        while heap and getattr(self.tracked.get(heap[0][1]), "kind", None) != "breakable":
-            heapq.heappop(heap)                  # broken since: drop lazily
-        top = (heap[0] if heap else None, O.dt)
-        if top == self._auto_key:              # nothing changed: keep k (no numpy per step)
+        smallest = self._smallest_breakable()
+        key = (smallest, O.dt)
+        if key == self._auto_key:              # nothing changed: keep k (no numpy per step)
             return
-        self._auto_key = top
+        self._auto_key = key
         k = 1
-        if heap:
-            radius, bid = heap[0]
+        if smallest is not None:
+            radius, bid = smallest
             mat = O.bodies[bid].material
             tr = float(placement.rayleigh_time(radius, mat.density, mat.young, mat.poisson))
             k = max(1, int(self.options.read_fraction * tr / O.dt))
-        if k != self.period:
-            self.period = k
-            _find_engine(self.label).iterPeriod = k
+        self._set_period(k)
 
     def _stored_share(self, touching):
         """Elastic energy (J) a body holds now in its counted contacts: its share of
@@ -690,8 +696,14 @@ class Breakage:
         st.event_max = 0.0
         st.specific_energy = 0.0
         self.open_events.discard(bid)
-        for c, slot in touching:            # the next event starts from the present state
-            c[slot] = c[2] + self.options.cs * c[9]
+        self._restart_offsets(touching)      # the next event starts from the present state
+
+    def _restart_offsets(self, touching):
+        """Count a body's energy from now on: its offsets in its contacts (slot 3 or 4) become
+        the contacts' present work."""
+        cs = self.options.cs
+        for c, slot in touching:
+            c[slot] = c[2] + cs * c[9]
 
     # -- breakage and replacement ----------------------------------------------------------------
     def _break_all(self, broken, contacts):
@@ -913,7 +925,12 @@ class Breakage:
         ph = inter.phys
         key = (min(id_a, id_b), max(id_a, id_b))
         # the zero engine scales kno, kso before the next force evaluation
-        self.zeroed[key] = [(1.0 - self.options.local_damping) * artificial, ph.kno, ph.kso]
+        self._register_zeroed(key, [(1.0 - self.options.local_damping) * artificial, ph.kno,
+                                    ph.kso])
+
+    def _register_zeroed(self, key, zero):
+        """Track a zeroed pair: [artificial overlap (m), kno0, kso0], indexed by both bodies."""
+        self.zeroed[key] = zero
         for i in key:
             self.zero_by_body.setdefault(i, set()).add(key)
 
@@ -1029,9 +1046,7 @@ class Breakage:
         self.open_events = {i for i in data["tracked"] if self.bodies[i].event_max > 0.0}
         self.contacts = {(a, b): c for a, b, c in data["contacts"]}
         for a, b, z in data["zeroed"]:
-            self.zeroed[(a, b)] = z
-            self.zero_by_body.setdefault(a, set()).add((a, b))
-            self.zero_by_body.setdefault(b, set()).add((a, b))
+            self._register_zeroed((a, b), z)
         self.damped_until = [tuple(x) for x in data["damped_until"]]
         self.events = data["events"]
         self.ledger = data["ledger"]
@@ -1149,7 +1164,8 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     event_log (a JSON-lines path), read_period (1: contacts read every step; an integer k; or
     "auto": every k steps with k dt <= read_fraction (0.05) of the Rayleigh time of the smallest
     breakable body, so contacts of bodies that can break are sampled as finely as the paper's
-    5 % time step while dt follows the finest fragment), pause_steps (steps after its creation
+    5 % time step while dt follows the finest fragment; or "fast": as often as the loading requires,
+    see Breakage._fast_period, tuned by fast_fraction (0.25) and fast_tolerance (0.02)), pause_steps (steps after its creation
     during which a fragment counts no energy: Rocky's safeguard; default 25 for Ab-T10 materials,
     0 for Tavares ones), fragments_energy_factor (1; multiplies the specific energy fragments see).
     Each material file chooses its criterion (breakage.model = "tavares" or "ab_t10"); one scene
@@ -1201,8 +1217,7 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
         Path(opts.event_log).parent.mkdir(parents=True, exist_ok=True)
         open(opts.event_log, "w").close()
     runner = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run({label!r})",
-                               iterPeriod=(1 if opts.read_period in ("auto", "fast")
-                                           else opts.read_period),
+                               iterPeriod=ctl.period,
                                initRun=True, label=label)
     zero = _wrapper.PyRunner(command=f"__import__('yadebreak.coupling').coupling._run_zero({label!r})",
                              iterPeriod=1, initRun=True, label=label + "_zero", dead=True)
@@ -1213,6 +1228,11 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     _REGISTRY[label] = ctl
     ctl.sync_tags()
     return ctl
+
+
+def _is_count(value, smallest):
+    """An integer (not a bool) of at least `smallest`."""
+    return isinstance(value, int) and not isinstance(value, bool) and value >= smallest
 
 
 def _check_options(opts):
@@ -1237,18 +1257,14 @@ def _check_options(opts):
         problems.append(f"time_step_fraction = {opts.time_step_fraction}: accepted (0, 1]")
     if opts.dummies not in ("spheres", "ledger"):
         problems.append(f"dummies = {opts.dummies!r}: accepted 'spheres' or 'ledger'")
-    if not (opts.read_period in ("auto", "fast") or (isinstance(opts.read_period, int)
-                                                     and not isinstance(opts.read_period, bool)
-                                                     and opts.read_period >= 1)):
+    if not (opts.read_period in ("auto", "fast") or _is_count(opts.read_period, 1)):
         problems.append(f"read_period = {opts.read_period!r}: accepted an integer >= 1, 'auto' "
                         "or 'fast'")
     if not (0.0 < opts.fast_fraction <= 1.0):
         problems.append(f"fast_fraction = {opts.fast_fraction}: accepted (0, 1]")
     if not (0.0 < opts.fast_tolerance <= 1.0):
         problems.append(f"fast_tolerance = {opts.fast_tolerance}: accepted (0, 1]")
-    if opts.pause_steps is not None and not (isinstance(opts.pause_steps, int)
-                                             and not isinstance(opts.pause_steps, bool)
-                                             and opts.pause_steps >= 0):
+    if opts.pause_steps is not None and not _is_count(opts.pause_steps, 0):
         problems.append(f"pause_steps = {opts.pause_steps!r}: accepted an integer >= 0 or None")
     if not (0.0 < opts.fragments_energy_factor <= 1.0):
         problems.append(f"fragments_energy_factor = {opts.fragments_energy_factor}: accepted (0, 1]")
