@@ -27,13 +27,10 @@ from yadebreak import coupling, scenes  # noqa: E402
 mat, steel = load_material(args.material), load_material("steel")
 out = Path(args.out)
 out.mkdir(parents=True, exist_ok=True)
-results = []
 start = time.time()
+energies = [float(e) for e in args.energies.split(",")]
 partial = PartialResults(out, args)
-for k, energy in enumerate(float(e) for e in args.energies.split(",")):
-    if partial.get(energy) is not None:
-        results.append(partial.get(energy))
-        continue
+for k, energy in partial.todo(energies):
     brk, ids, strikers = scenes.drop_weight_scene(
         args.material, args.size, energy, args.particles, args.striker_mass_ratio,
         seed=args.seed + k, time_step_fraction=args.time_step_fraction,
@@ -45,13 +42,11 @@ for k, energy in enumerate(float(e) for e in args.energies.split(",")):
     brk.finish()
     result = reports.breakage_result(brk, ids, mat, args.size, energy, steel)
     result["mass_relative_error"] = abs(brk.total_mass() - initial_mass) / initial_mass
-    results.append(result)
     partial.add(energy, result)
-    if args.stop_after and len(partial.done) >= args.stop_after:
-        sys.exit(0)                          # as if killed here (tests)
     progress(f"{energy:g} J/kg: {100 * result['broken_fraction']:.1f} % broken (model "
              f"{100 * result['model_probability']:.1f} %), {time.time() - start:.1f} s")
 
+results = partial.ordered(energies)
 (out / "summary.json").write_text(json.dumps({"material": mat.name, "size": args.size,
                                               "results": results,
                                               "runtime_s": time.time() - start}, indent=2))

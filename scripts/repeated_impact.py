@@ -21,7 +21,8 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 import numpy as np  # noqa: E402
 
 from yadebreak import load_material, model  # noqa: E402
-from yadebreak.scriptargs import progress, script_params  # noqa: E402
+from yadebreak.scriptargs import (check_resume_arguments, progress, resume_arguments,  # noqa: E402
+                                  script_params, stop_if_asked)
 
 args = script_params(dict(material="copper_ore", size=37.5e-3, particles=100, impacts=20,
                           energy=94.7, gamma=0.0, seed=1, target="steel",
@@ -44,9 +45,7 @@ start = time.time()
 checkpoint = out / "checkpoint.yade.gz"
 if args.resume:
     brk, loop = coupling.load_checkpoint(checkpoint)
-    if loop["arguments"] != repr(sorted((k, v) for k, v in vars(args).items()
-                                        if k not in ("resume", "stop_after"))):
-        sys.exit(f"--resume: {checkpoint} was written with other arguments; run without --resume")
+    check_resume_arguments(loop["arguments"], args, checkpoint)
     ids, alive, fractions = loop["ids"], loop["alive"], loop["fractions"]
     home = {int(i): tuple(p) for i, p in loop["home"].items()}
     progress(f"resumed from {checkpoint} after impact {len(fractions)}")
@@ -64,10 +63,8 @@ for k in range(len(fractions), args.impacts):
     progress(f"impact {k + 1}: {100 * fractions[-1]:.0f} % broken, {time.time() - start:.1f} s")
     coupling.save_checkpoint(checkpoint, {
         "ids": ids, "alive": alive, "fractions": fractions, "home": home,
-        "arguments": repr(sorted((k, v) for k, v in vars(args).items()
-                                 if k not in ("resume", "stop_after")))})
-    if args.stop_after and len(fractions) >= args.stop_after:
-        sys.exit(0)                          # as if killed here (tests)
+        "arguments": resume_arguments(args)})
+    stop_if_asked(args, len(fractions))
 
 if mat.is_ab_t10:
     model_fractions = model.ab_t10_repeated_broken_fraction(

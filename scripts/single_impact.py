@@ -32,13 +32,10 @@ mat, target = load_material(args.material), load_material(args.target)
 share = mat.energy_partition(target)
 out = Path(args.out)
 out.mkdir(parents=True, exist_ok=True)
-results = []
 start = time.time()
+energies = [float(e) for e in args.energies.split(",")]
 partial = PartialResults(out, args)
-for k, energy in enumerate(float(e) for e in args.energies.split(",")):
-    if partial.get(energy) is not None:
-        results.append(partial.get(energy))
-        continue
+for k, energy in partial.todo(energies):
     speed = float(np.sqrt(2 * energy))
     brk, ids = scenes.impact_scene(args.material, args.size, [speed] * args.particles,
                                    target=args.target, seed=args.seed + k, replace=args.replace,
@@ -53,14 +50,12 @@ for k, energy in enumerate(float(e) for e in args.energies.split(",")):
         "mean_specific_energy_measured": (float(np.mean([e["specific_energy"] / share
                                                          for e in intact])) if intact else None),
         "mass_relative_error": abs(brk.total_mass() - initial_mass) / initial_mass})
-    results.append(result)
     partial.add(energy, result)
-    if args.stop_after and len(partial.done) >= args.stop_after:
-        sys.exit(0)                          # as if killed here (tests)
     progress(f"{energy:g} J/kg: {100 * result['broken_fraction']:.1f} % broken (model "
              f"{100 * result['model_probability']:.1f} %), {steps} steps, "
              f"{time.time() - start:.1f} s")
 
+results = partial.ordered(energies)
 summary = {"material": mat.name, "size": args.size, "target": args.target, "share_e": share,
            "results": results, "runtime_s": time.time() - start}
 (out / "summary.json").write_text(json.dumps(summary, indent=2))

@@ -40,41 +40,65 @@ def progress(message):
     print(f"[yadebreak] {message}", flush=True)
 
 
+def resume_arguments(args):
+    """The arguments that decide a run's results (not --resume, --stop-after or --out): what a
+    resumed run must share with the one it continues."""
+    return {k: v for k, v in sorted(vars(args).items())
+            if k not in ("resume", "out", "stop_after")}
+
+
+def check_resume_arguments(saved, args, path):
+    """Refuse to resume, naming the arguments that differ, when `saved` (resume_arguments of the
+    interrupted run, stored at `path`) are not this run's."""
+    now = resume_arguments(args)
+    if saved != now:
+        changed = sorted(k for k in set(saved) | set(now) if saved.get(k) != now.get(k))
+        raise SystemExit(f"--resume: {path} was written with other values of {changed}; run "
+                         "again without --resume or with the same values")
+
+
+def stop_if_asked(args, units_done):
+    """--stop-after N: end the script here, as if killed, once N units are done (tests)."""
+    if getattr(args, "stop_after", 0) and units_done >= args.stop_after:
+        sys.exit(0)
+
+
 class PartialResults:
     """Results a script has finished, kept in <out>/partial.json as it goes, so that `--resume 1`
     skips what an interrupted run completed. Each unit of work (an energy) must depend only on the
     arguments and its own seed, so that resuming gives what an uninterrupted run gives.
 
         partial = PartialResults(out, args)          # args.resume decides
-        for energy in energies:
-            result = partial.get(energy) or compute(energy)
-            partial.add(energy, result)
+        for k, energy in partial.todo(energies):     # the units not done yet
+            partial.add(energy, compute(k, energy))  # stops here with --stop-after
+        results = partial.ordered(energies)
     """
 
     def __init__(self, out, args):
         import json
         from pathlib import Path
         self.path = Path(out) / "partial.json"
-        self.arguments = {k: v for k, v in sorted(vars(args).items())
-                          if k not in ("resume", "out", "stop_after")}
+        self.args = args
         self.done = {}
         if getattr(args, "resume", False) and self.path.exists():
             data = json.loads(self.path.read_text())
-            if data["arguments"] != self.arguments:
-                changed = sorted(k for k in set(data["arguments"]) | set(self.arguments)
-                                 if data["arguments"].get(k) != self.arguments.get(k))
-                raise SystemExit(f"--resume: {self.path} was written with other values of "
-                                 f"{changed}; run again without --resume or with the same values")
+            check_resume_arguments(data["arguments"], args, self.path)
             self.done = data["done"]
             progress(f"resuming: {len(self.done)} finished unit(s) kept from {self.path}")
 
-    def get(self, key):
-        return self.done.get(str(key))
+    def todo(self, keys):
+        """(index, key) of the units not done yet, in order."""
+        return [(k, key) for k, key in enumerate(keys) if str(key) not in self.done]
+
+    def ordered(self, keys):
+        """Every unit's result, in the order of `keys`."""
+        return [self.done[str(key)] for key in keys]
 
     def add(self, key, result):
         import json
         import os
         self.done[str(key)] = result
         tmp = self.path.with_suffix(".tmp")
-        tmp.write_text(json.dumps({"arguments": self.arguments, "done": self.done}))
+        tmp.write_text(json.dumps({"arguments": resume_arguments(self.args), "done": self.done}))
         os.replace(tmp, self.path)
+        stop_if_asked(self.args, len(self.done))
