@@ -210,14 +210,14 @@ _TAVARES = [
     ("b_prime", 0.0, False, math.inf, False, "-", 1.0),
     ("kappa", 0.0, False, math.inf, False, "-", 1.0),
 ]
-_TAVARES_DEFAULTS = {"emax_ratio": 100.0, "kappa": 1.0}
 _AB_T10 = [
     ("e_min_ref", 0.0, True, math.inf, False, "J/kg", 1.0),
     ("size_ref", 0.0, False, math.inf, False, "mm", 1e-3),
     ("selection", 0.0, False, math.inf, False, "kg/J", 1.0),
     ("t10_max", 0.0, False, 100.0, True, "%", 1.0),
 ]
-_MODELS = {"tavares": _TAVARES, "ab_t10": _AB_T10}
+#: breakage.model -> (its keys, the defaults of the optional ones)
+_MODELS = {"tavares": (_TAVARES, {"emax_ratio": 100.0, "kappa": 1.0}), "ab_t10": (_AB_T10, {})}
 #: Ab-T10 events with t10 below this (%) take the family set at this t10 (see Material.t10_min):
 #: below it the 11 classes cannot follow Eq. 10 within 2 % (2.6 % at t10 = 1 %).
 AB_T10_T10_FLOOR = 2.0
@@ -327,14 +327,14 @@ def _parse(doc, source):
             problems.append(f"breakage.model = {model_name!r}: accepted 'tavares' (the default) "
                             "or 'ab_t10'")
             model_name = "tavares"
-        fields = _MODELS[model_name]
+        fields, defaults = _MODELS[model_name]
         allowed = {k[0] for k in fields} | {"model", "beta", "beta_source"}
         if model_name == "tavares":
             allowed.add("device_stiffness")
         _check_keys(breakage, allowed, "breakage", problems)
         for key, lo, lo_inc, hi, hi_inc, unit, factor in fields:
             v = _number(breakage, key, "breakage", problems, lo, lo_inc, hi, hi_inc, unit,
-                        default=_TAVARES_DEFAULTS.get(key) if model_name == "tavares" else None)
+                        default=defaults.get(key))
             values[key] = None if v is None else v * factor
         if model_name == "tavares":
             dev = _number(breakage, "device_stiffness", "breakage", problems, 0.0, False, 1500.0,

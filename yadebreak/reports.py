@@ -19,7 +19,8 @@ def first_events(events, ids):
 def breakage_result(brk, ids, material, size, specific_energy, partner):
     """Broken fraction of the particles `ids` beside the model's probability P(e Ek/mp), and,
     when any broke, the progeny's size distribution (fines included, sieves below the feed size)
-    and t10 beside Eq. 8 (mean over the events) and Eq. 10."""
+    and t10 beside the model's (t10_model: the events' mean, Eq. 8 or, for Ab-T10, Eq. 9.4) and
+    Eq. 10."""
     first = first_events(brk.events, ids)
     broken = [e for e in first.values() if e["kind"] == "breakage"]
     p_model = float(material.breakage_probability(specific_energy, size, partner=partner))
@@ -42,7 +43,7 @@ def breakage_result(brk, ids, material, size, specific_energy, partner):
         result.update({
             "t10_simulated": float(100 * brk.size_distribution([size / 10]).passing_mass[0]
                                    / parent_mass),
-            "t10_model_eq8": float(t10_events.mean()),
+            "t10_model": float(t10_events.mean()),
             "relative_sizes": (sieves / size).tolist(),
             "progeny_passing_simulated": passing.tolist(),
             "progeny_passing_model": model.progeny_passing(
@@ -79,7 +80,7 @@ def plot_breakage(results, material, size, partner, title, path, label="simulati
             axes[1].semilogx(r["relative_sizes"], r["progeny_passing_simulated"], "o", ms=4,
                              c=f"C{k}", label=f"simulation, t10 {r['t10_simulated']:.1f} % "
                                               f"({'Eq. 9.4' if material.is_ab_t10 else 'Eq. 8'}: "
-                                              f"{r['t10_model_eq8']:.1f} %)")
+                                              f"{r['t10_model']:.1f} %)")
     axes[1].set(xlabel="relative size d / d_parent", ylabel="progeny passing (%)",
                 title="progeny of broken particles (fines included)")
     axes[1].legend(fontsize=7)
