@@ -45,13 +45,26 @@ def _impact(size=SIZE, speed=20.0, material=None, **options):
     return build
 
 
+def _ore_scene():
+    """A fresh scene with the ore and steel materials; returns (Ip2 functor, ore Material)."""
+    O.reset()
+    ore = _material()
+    ip2, _ = add_materials({"ore": ore, "steel": "steel"})
+    return ip2, ore
+
+
+def _set_fracture_energy(brk, ids, energy):
+    """Give the bodies `ids` one fracture energy (J/kg), so that they break together."""
+    for i in ids:
+        brk.bodies[i].fracture_energy = brk.bodies[i].fracture_energy_initial = energy
+
+
 def _all_break_at_once(n):
     """n identical particles hit the plate in the same step with one low fracture energy: they
     all break in that step (fragments kept unbreakable, dmin = the size, to keep the run short)."""
     brk, ids = scenes.impact_scene(_material(), SIZE, [30.0] * n, seed=4, dummies="ledger",
                                    dmin=SIZE)
-    for i in ids:
-        brk.bodies[i].fracture_energy = brk.bodies[i].fracture_energy_initial = 50.0
+    _set_fracture_energy(brk, ids, 50.0)
     return brk, ids
 
 
@@ -70,8 +83,7 @@ def _break_now(ratio, size=SIZE):
 def _head_on(n):
     """Pairs of touching, identical particles (same fracture energy) fired at each other: both
     break in the same step, each touching the other."""
-    O.reset()
-    ip2, _ = add_materials({"ore": _material(), "steel": "steel"})
+    ip2, ore = _ore_scene()
     r = SIZE / 2.0
     ids = []
     for k in range(n):
@@ -81,17 +93,15 @@ def _head_on(n):
             b.state.vel = (-sign * 15.0, 0.0, 0.0)
             ids.append(O.bodies.append(b))
     O.engines = scenes.hertz_engines(ip2)
-    brk = attach({"ore": _material()}, seed=4, dummies="ledger")
-    for i in ids:
-        brk.bodies[i].fracture_energy = brk.bodies[i].fracture_energy_initial = 30.0
+    brk = attach({"ore": ore}, seed=4, dummies="ledger")
+    _set_fracture_energy(brk, ids, 30.0)
     return brk, ids
 
 
 def _in_facet_corner(n):
     """Particles resting in a corner of a wall and two facets (a floor and a side) broken at once:
     fragments placed against a wall and facets."""
-    O.reset()
-    ip2, _ = add_materials({"ore": _material(), "steel": "steel"})
+    ip2, ore = _ore_scene()
     r = SIZE / 2.0
     ids = []
     for k in range(n):
@@ -106,8 +116,8 @@ def _in_facet_corner(n):
     b = O.bodies[ids[0]]
     b.state.pos = (-4 * SIZE + r, 0.0, r)          # the first one touches the wall as well
     O.engines = scenes.hertz_engines(ip2, facets=True)
-    brk = attach({"ore": _material()}, seed=4, dummies="ledger")
-    O.run(1, True)                                 # contacts exist before the breakage
+    brk = attach({"ore": ore}, seed=4, dummies="ledger")
+    coupling.run_steps(1)                          # contacts exist before the breakage
     for i in ids:
         brk.break_body(i, ratio=3.0, direction=(0.0, 0.0, -1.0))
     return brk, ids
