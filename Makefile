@@ -33,3 +33,4 @@ test-model:
 bench: deps
 	$(PY) benchmarks/bench_families.py
 	$(PY) benchmarks/bench_engine.py
+	$(PY) benchmarks/bench_energy.py
