@@ -18,7 +18,7 @@ SPEEDS = (1.0, 5.0, 14.14, 20.0, 28.28, 100.0)
 
 
 def errors(read_period):
-    coupling._REGISTRY.clear()
+    coupling.forget()
     share = load_material("copper_ore").energy_partition(load_material("steel"))
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=SPEEDS, emin=0.0,
                                    read_period=read_period)

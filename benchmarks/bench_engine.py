@@ -21,7 +21,7 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 import numpy as np  # noqa: E402
 
 from yadebreak import coupling, scenes  # noqa: E402
-from yadebreak.coupling import O, _wrapper, utils  # noqa: E402
+from yadebreak.coupling._yade import O, utils, wrapper as _wrapper  # noqa: E402
 
 QUICK = "--quick" in sys.argv
 # O.run(n, True) waits in 40 ms polls, so steps are timed with coupling.run_steps (O.step in a
@@ -41,7 +41,7 @@ def bed_rate(rings, layers, mode):
 
 
 def _bed_rate_once(rings, layers, mode):
-    coupling._REGISTRY.clear()
+    coupling.forget()
     options = {} if mode in ("plain", "noop") else {"read_period": 1 if mode == "exact" else mode}
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, rings, layers, 3.05, seed=1,
                                         **options)
@@ -87,7 +87,7 @@ def per_step_table():
 def cloud(n, dummies="spheres"):
     """n spheres of 5.5 mm on a loose cubic grid (no contacts), and a controller."""
     O.reset()
-    coupling._REGISTRY.clear()
+    coupling.forget()
     ip2, _ = coupling.add_materials({"ore": "copper_ore"})
     side = int(np.ceil(n ** (1 / 3)))
     pitch = 6e-3
@@ -152,7 +152,7 @@ def end_to_end():
     from yadebreak import bed
     print("\n3. The default bed impact end to end (target 3 minutes), where the time goes")
     for read, dummies in (("fast", "ledger"), (1, "spheres")):
-        coupling._REGISTRY.clear()
+        coupling.forget()
         with tempfile.TemporaryDirectory() as out:
             args = argparse.Namespace(material="copper_ore", size=5.5e-3, rings=3, layers=1,
                                       energy=3.05, speed=0.0, seed=1, time_step_fraction=0.05,

@@ -32,7 +32,7 @@ rows = []
 
 
 def single(tsf, stiffness, read, n=250, energy=400.0):
-    coupling._REGISTRY.clear()
+    coupling.forget()
     speed = (2 * energy) ** 0.5
     t0 = time.time()
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [speed] * n, seed=3, replace=False,
@@ -61,7 +61,7 @@ def _mean_t10(events):
 
 
 def bed_run(tsf, read, dummies, dmin_ratio):
-    coupling._REGISTRY.clear()
+    coupling.forget()
     a = argparse.Namespace(material="copper_ore", size=5.5e-3, rings=3, layers=1, energy=3.05,
                            speed=0.0, seed=1, time_step_fraction=tsf, dmin=5.5e-3 / dmin_ratio,
                            global_damping=0.0, dummies=dummies, read_period=read, max_time=0.004,

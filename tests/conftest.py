@@ -19,12 +19,8 @@ def scene():
     """A fresh YADE scene (one Omega per process) and a clean yadebreak registry."""
     from yade import O
     from yadebreak import coupling
-    for ctl in coupling._REGISTRY.values():
-        ctl.close()
-    coupling._REGISTRY.clear()
+    coupling.forget()
     O.reset()
     yield O
-    for ctl in coupling._REGISTRY.values():
-        ctl.close()
-    coupling._REGISTRY.clear()
+    coupling.forget()
     O.reset()

@@ -40,7 +40,7 @@ def test_higher_energy_breaks_more_mass(scene, tmp_path):
     from yade import O
     masses = []
     for energy in (0.3, 0.9):
-        coupling._REGISTRY.clear()
+        coupling.forget()
         O.reset()
         _, summary = bed.run(_args(tmp_path / f"e{energy}", energy, seed=5), quiet=True)
         masses.append(summary["broken_mass"])
@@ -68,7 +68,7 @@ def test_resume_continues_exactly_like_an_uninterrupted_run(scene, tmp_path):
     _, reference = bed.run(whole, quiet=True)
     reference_events = (tmp_path / "whole" / "events.jsonl").read_text()
 
-    coupling._REGISTRY.clear()
+    coupling.forget()
     O.reset()
     died = _args(tmp_path / "died", 0.9, seed=5)
     died.checkpoint_every = 0.0                    # after every chunk
@@ -76,7 +76,7 @@ def test_resume_continues_exactly_like_an_uninterrupted_run(scene, tmp_path):
     brk, summary = bed.run(died, quiet=True)
     assert summary is None and (tmp_path / "died" / "checkpoint.yade.gz").exists()
     assert 0 < len(brk.breakage_events) < reference["breakage_events"]
-    coupling._REGISTRY.clear()
+    coupling.forget()
     O.reset()
     died.stop_after, died.resume = 0.0, True
     _, resumed = bed.run(died, quiet=True)

@@ -77,12 +77,12 @@ def _events_for(seed, steps_before=None, tmp_path=None, material="limestone", re
     if steps_before is not None:
         O.run(steps_before, True)
         path = str(tmp_path / "mid.yade.gz")
-        O.save(path)
+        coupling.save(path)                # O.save with yadebreak's state
         O.run(137, True)                   # wander on, then come back to the saved state
-        coupling._REGISTRY.clear()         # as in a new process
+        coupling.forget()                  # as in a new process
         O.load(path)
     O.run(1500 - (steps_before or 0), True)
-    brk = coupling._REGISTRY["yadebreak"]
+    brk = coupling.controller()
     return [(e["kind"], e["id"], e["iter"], round(e["specific_energy"], 9),
              round(e["fracture_energy"], 9)) for e in brk.events]
 

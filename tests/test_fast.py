@@ -75,7 +75,7 @@ def test_fast_single_impacts_break_as_every_step_reading(scene, material, energy
     from yadebreak import coupling, scenes
     got = {}
     for mode in (1, "fast"):
-        coupling._REGISTRY.clear()
+        coupling.forget()
         brk, ids = scenes.impact_scene(material, 5.5e-3, [math.sqrt(2 * energy)] * 250,
                                        seed=3, replace=False, read_period=mode)
         scenes.run_until_rebound(ids)

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from . import coupling, scenes
-from .coupling import O
+from .coupling._yade import O, wrapper
 from .scriptargs import progress
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
@@ -40,11 +40,10 @@ def capture_radius(brk, info):
 
 def write_vtk(path, brk):
     """Legacy VTK polydata of every sphere: radius, fracture energy, damage, class."""
-    from .coupling import _wrapper
     classes = {"breakable": 0, "unbreakable": 1, "dummy": 2}
     rows = []
     for b in O.bodies:
-        if b is None or not isinstance(b.shape, _wrapper.Sphere):
+        if b is None or not isinstance(b.shape, wrapper.Sphere):
             continue
         st = brk.bodies.get(b.id)
         fe = st.fracture_energy if st is not None and math.isfinite(st.fracture_energy) else -1.0

@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import coupling, scenes
-from .coupling import O, _REGISTRY, add_materials, attach, utils
+from .coupling import add_materials, attach
+from .coupling._yade import O, utils
 from .materials import load_material
 
 SIZE = 5.5e-3
@@ -159,10 +160,7 @@ def _kinetic(brk):
         if b is not None and b.dynamic:
             total += 0.5 * b.state.mass * b.state.vel.squaredNorm()
             total += 0.5 * b.state.inertia[0] * b.state.angVel.squaredNorm()
-    for mass, *rest in brk.ledger:               # ledger fines carry their momentum
-        momentum = np.array(rest[-3:])
-        total += 0.5 * momentum @ momentum / mass
-    return total
+    return total + brk.ledger.kinetic_energy()   # ledger fines carry their momentum
 
 
 def _finite():
@@ -177,9 +175,7 @@ def _finite():
 
 def run_case(case, fast=False):
     """Build, run to the end (every fired body or its fragments away and free) and measure."""
-    for ctl in _REGISTRY.values():
-        ctl.close()
-    _REGISTRY.clear()
+    coupling.forget()
     t0 = time.time()
     n = case.n_fast if fast else case.n
     brk, ids = case.build(n)

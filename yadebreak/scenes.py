@@ -6,7 +6,8 @@ import math
 import numpy as np
 
 # the coupling makes yade importable from Debian's python3 first
-from .coupling import O, _wrapper as _w, add_materials, attach, run_steps, utils
+from .coupling import add_materials, attach, run_steps
+from .coupling._yade import O, utils, wrapper as _w
 
 
 def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False):

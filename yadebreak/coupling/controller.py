@@ -1,0 +1,390 @@
+"""The per-step engine: read -> judge -> log -> replace (and zero) -> time step -> reschedule.
+
+One Controller per attached engine; `attach()` (engine.py) makes it and its PyRunners call
+`step()` after the InteractionLoop and the zeroing before it. Each part lives in its own module:
+contacts (reading), criteria (judging), state (bodies, events, ledger), replacement, zeroing,
+stepping (read schedule, time step, fragment damping).
+"""
+from __future__ import annotations
+
+import sys
+import time
+import warnings
+
+import numpy as np
+
+from .. import families, reports
+from ._yade import O, wrapper
+from .config import AttachError
+from .contacts import ContactReader
+from .criteria import criterion_for
+from .replacement import Replacer
+from .state import BREAKABLE, BROKEN, UNBREAKABLE, BodyRow, EngineState
+from .stepping import FragmentDamping, ReadSchedule, SmallestBreakable, TimeStep
+from .zeroing import OverlapZeroing
+
+
+class Controller:
+    """The engine of one scene: its state, its parts, and the results (`events`,
+    `size_distribution`, `body_state`)."""
+
+    def __init__(self, label, config, scene_materials, material_names, state=None):
+        self.label = label
+        self.config = config
+        self.material_names = dict(material_names)      # as given to attach (saved)
+        self.material = scene_materials.by_label         # YADE label -> Material
+        self.label_by_id = scene_materials.label_by_id
+        self.criteria = {lab: criterion_for(mat) for lab, mat in self.material.items()}
+        labels = list(self.material)
+        self.state = state or EngineState(labels, config.seed, config.output.event_log)
+        # criterion of each material index of the body table
+        self._criterion_of = [self.criteria[lab] for lab in self.state.table.labels]
+        self.pause_steps = {lab: (config.criteria.pause_steps if config.criteria.pause_steps
+                                  is not None else crit.default_pause_steps)
+                            for lab, crit in self.criteria.items()}
+        self.reader = ContactReader(scene_materials.stiffness_by_id, config.reading.cs,
+                                    config.reading.emin)
+        self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero")
+        self.smallest = SmallestBreakable()
+        self.schedule = ReadSchedule(config.reading, label, self._smallest_breakable)
+        self.time_step = TimeStep(config.time_step.time_step_fraction, self._warn_once)
+        self.damping = FragmentDamping(config.time_step.global_damping,
+                                       config.time_step.global_damping_time)
+        tables = {lab: families.table_for(mat, config.replacement.family_seed)
+                  for lab, mat in self.material.items()}
+        self.replacer = Replacer(config.replacement, self.state.table, self.state.rng,
+                                 self.criteria, tables, self.zeroing, self.state.ledger,
+                                 self.pause_steps, config.time_step.global_damping > 0.0)
+        self.last_iter = -1
+        self.wall_time = {"read": 0.0, "replace": 0.0}
+
+    # -- what users read ---------------------------------------------------------------------
+    @property
+    def bodies(self):
+        """The body table: bodies[i].fracture_energy etc. (state.BodyTable)."""
+        return self.state.table
+
+    @property
+    def events(self):
+        return self.state.log.events
+
+    @property
+    def breakage_events(self):
+        return [e for e in self.events if e["kind"] == "breakage"]
+
+    @property
+    def ledger(self):
+        return self.state.ledger
+
+    @property
+    def warned(self):
+        return self.state.warned
+
+    @property
+    def period(self):
+        """Steps between reads now."""
+        return self.schedule.period
+
+    @property
+    def zeroed(self):
+        """{(id_a, id_b): ZeroedOverlap} of the pairs whose artificial overlap is zeroed."""
+        return self.zeroing.pairs
+
+    def body_state(self, body_id):
+        """State of a body as a dict (fracture_energy, damage, kind, specific_energy...)."""
+        return self.state.table[body_id].as_dict()
+
+    def total_mass(self):
+        """Mass (kg) of every body yadebreak knows, fragments and ledger fines included."""
+        return self.state.total_mass()
+
+    def size_distribution(self, sizes, fines=True, fines_model="gaudin_schuhmann"):
+        """The product size distribution, fines included (reports.product_size_distribution)."""
+        return reports.product_size_distribution(self.state.table, self.state.ledger,
+                                                 self.material, sizes, fines, fines_model)
+
+    # -- set-up --------------------------------------------------------------------------------
+    def register_bodies(self):
+        """Give every breakable sphere of the scene its state and fracture energy (attach)."""
+        found, problems = [], []
+        for b in O.bodies:
+            if b is None or b.id in self.state.table:
+                continue
+            label = self.label_by_id.get(b.material.id if b.material is not None else None)
+            if label is None:
+                continue
+            if not isinstance(b.shape, wrapper.Sphere):
+                problems.append(f"body {b.id} ({type(b.shape).__name__}) has the breakable material "
+                                f"'{label}' but only spheres can break: give it another material")
+            elif b.isClumpMember or b.isClump:
+                problems.append(f"body {b.id} is part of a clump and has the breakable material "
+                                f"'{label}': clumps cannot break; use loose spheres")
+            else:
+                found.append((b.id, label, b.state.mass, b.shape.radius))
+        if problems:
+            raise AttachError("; ".join(problems))
+        if not found:
+            return
+        ids = np.array([f[0] for f in found])
+        labels = [f[1] for f in found]
+        sizes = np.array([2.0 * f[3] for f in found])
+        table = self.state.table
+        for label in dict.fromkeys(labels):         # draws per material, in id order: reproducible
+            idx = np.array([k for k, lab in enumerate(labels) if lab == label])
+            energies, extra = self.criteria[label].sample(self.state.rng, sizes[idx])
+            table.add(ids[idx], BREAKABLE, label, [found[k][2] for k in idx], sizes[idx] / 2.0,
+                      fracture_energy=energies, fracture_energy_initial=energies, **extra)
+        # rows were added per material: restore the scene's order (sums follow it)
+        table.known = dict.fromkeys(ids.tolist())
+        self._adopt(ids.tolist())
+        self.state.top_size = max(self.state.top_size, float(sizes.max()))
+
+    def _adopt(self, ids):
+        """Track new bodies: breakable and unbreakable ones are read; breakable ones may set the
+        read schedule. Each YADE body gets its row as `body.breakage`."""
+        table = self.state.table
+        kind, radius = table.columns["kind"], table.columns["radius"]
+        for i in ids:
+            k = kind[i]
+            if k == BREAKABLE or k == UNBREAKABLE:
+                self.state.tracked.add(i)
+            if k == BREAKABLE:
+                self.smallest.push(float(radius[i]), i)
+            O.bodies[i].breakage = BodyRow(table, i)
+
+    def _smallest_breakable(self):
+        kind = self.state.table.columns["kind"]
+        return self.smallest.get(lambda i: i in self.state.tracked and kind[i] == BREAKABLE)
+
+    def _warn_once(self, cause, message):
+        if cause not in self.state.warned:
+            self.state.warned.add(cause)
+            warnings.warn(f"yadebreak: {message}", RuntimeWarning, stacklevel=3)
+            print(f"[yadebreak] WARNING: {message}", file=sys.stderr, flush=True)
+
+    # -- the per-step work -----------------------------------------------------------------------
+    def step(self):
+        """After the InteractionLoop, when the read schedule says: read -> judge -> log ->
+        replace -> time step -> reschedule."""
+        state = self.state
+        if not state.tracked and not state.open_events:
+            self.damping.release()
+            self.last_iter = O.iter               # nothing can break: next to no cost
+            return
+        t0 = time.perf_counter()
+        interval = max(1, O.iter - self.last_iter)        # steps since the last read
+        loading = self.reader.read(O.interactions, O.bodies, state.tracked, self.zeroing.pairs,
+                                   O.time, interval)
+        self.wall_time["read"] += time.perf_counter() - t0
+        broken, limits = self._judge(loading, interval)
+        if broken:
+            self._break_all(broken)
+        self.damping.release()
+        self.last_iter = O.iter
+        self.schedule.after_read(limits)
+
+    def _judge(self, loading, interval):
+        """Each body read now (or with an open event): paused, broken, loading, or unloaded (its
+        event closes with damage). Returns [(id, Ek', strongest contact)] of the broken bodies
+        and the steps the loaded ones allow before the next read."""
+        state = self.state
+        c = state.table.columns
+        energy = loading.energy
+        candidates = list(state.open_events.union(energy))
+        if not candidates:
+            return [], None
+        ids = np.fromiter(candidates, np.int64, len(candidates))
+        known = np.fromiter((i in state.tracked for i in candidates), bool, len(candidates))
+        paused = known & (c["pause_until"][ids] > O.iter)
+        active = known & ~paused
+        ek = np.fromiter((energy.get(i, 0.0) for i in candidates), float, len(candidates))
+        factor = self.config.criteria.fragments_energy_factor
+        if factor != 1.0:
+            ek = np.where(c["generation"][ids] > 0, ek * factor, ek)
+        specific = ek / c["mass"][ids]
+        verdict = self._verdicts(ids, active, ek, specific, interval)
+        breaks, jump, threshold, order, limits = verdict
+        c["specific_energy"][ids[active]] = specific[active]
+        grows = active & ~breaks & (ek > c["event_max"][ids])
+        was_open = c["event_max"][ids] > 0.0
+        c["event_max"][ids[grows]] = ek[grows]
+        c["event_max"][ids[paused]] = 0.0
+        c["specific_energy"][ids[paused]] = 0.0
+        return self._settle(candidates, known, paused, breaks, grows, was_open, jump, threshold,
+                            order, ek, loading), limits
+
+    def _verdicts(self, ids, active, ek, specific, interval):
+        """Each material's criterion on its active bodies (vectorised); the settling order
+        (criterion.order); the read schedule's limits."""
+        n = len(ids)
+        breaks = np.zeros(n, bool)
+        jump = np.zeros(n)
+        threshold = np.ones(n)
+        order = np.zeros(n, np.int8)
+        limits = []
+        materials = self.state.table.columns["material"][ids]
+        fast = self.schedule.mode == "fast"
+        for m in np.unique(materials[active]).tolist():
+            rows = np.nonzero(active & (materials == m))[0]
+            crit = self._criterion_of[m]
+            j = crit.judge(self.state.table, ids[rows], ek[rows], specific[rows])
+            breaks[rows], jump[rows], threshold[rows] = j.breaks, j.jump, j.threshold
+            order[rows] = crit.order
+            if fast and j.rising.any():
+                r = j.rising
+                limits.append(self.schedule.steps_allowed(j.threshold[r], j.level[r], j.rise[r],
+                                                          interval))
+        return breaks, jump, threshold, order, (np.concatenate(limits) if limits else None)
+
+    def _settle(self, candidates, known, paused, breaks, grows, was_open, jump, threshold, order,
+                ek, loading):
+        """Events open, close or break, body by body in the criteria's order (Tavares bodies,
+        then Ab-T10's: the order of the event log and of the random draws)."""
+        state = self.state
+        open_events = state.open_events
+        broken = []
+        for k in np.argsort(order, kind="stable").tolist():
+            i = candidates[k]
+            if not known[k]:
+                open_events.discard(i)
+            elif paused[k]:
+                # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
+                # did meanwhile is never counted later
+                self.reader.restart(loading.touching.get(i, ()))
+                open_events.discard(i)
+            elif breaks[k]:
+                if jump[k] > 0.8 * threshold[k]:
+                    self._warn_jump(i, jump[k], threshold[k])
+                broken.append((i, float(ek[k]), loading.strongest.get(i)))
+            elif grows[k]:
+                open_events.add(i)
+            elif (was_open[k] and i not in loading.grew
+                  and self.reader.stored_share(loading.touching.get(i, ())) <= self.reader.emin):
+                self._close_event(i, loading.touching.get(i, ()))
+        return broken
+
+    def _warn_jump(self, bid, rise, scale):
+        self._warn_once("jump", (
+            f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
+            f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s):"
+            f" reduce {self.schedule.remedy()} for an accurate t10'"))
+
+    def _close_event(self, bid, touching):
+        """End of a stressing event without breakage: the criterion's damage rule (Eqs. 5-6 or
+        9.2) with the event's largest Ek'; the next event starts from the present state."""
+        table = self.state.table
+        c = table.columns
+        event_max, mass = float(c["event_max"][bid]), float(c["mass"][bid])
+        fields = self._criterion_of[c["material"][bid]].unload(table, bid)
+        if fields is not None:
+            self._record("damage", bid, specific_energy=event_max / mass, **fields)
+        c["event_max"][bid] = c["specific_energy"][bid] = 0.0
+        self.state.open_events.discard(bid)
+        self.reader.restart(touching)
+
+    def _record(self, kind, bid, **fields):
+        c = self.state.table.columns
+        self.state.log.record({"kind": kind, "iter": O.iter, "time": O.time, "id": bid,
+                               "radius": float(c["radius"][bid]), "mass": float(c["mass"][bid]),
+                               **fields})
+
+    # -- breakage ---------------------------------------------------------------------------------
+    def _break_all(self, broken):
+        """Log each breakage, replace the spheres, then lower the time step for the finest
+        fragment (once for all the breakages of this read)."""
+        t0 = time.perf_counter()
+        state, table = self.state, self.state.table
+        c = table.columns
+        new_dt = np.inf
+        self.schedule.scene_changed()
+        dmin = self.config.replacement.dmin
+        dmin = dmin if dmin is not None else state.top_size / 20.0
+        for bid, ek, strongest in broken:
+            if bid not in state.tracked:
+                continue
+            label = table.label_of(bid)
+            ratio, t10, extra = self.criteria[label].breakage(table, bid, ek)
+            state.tracked.discard(bid)
+            energy = float(c["fracture_energy"][bid])
+            specific = ek / float(c["mass"][bid])
+            if c["kind"][bid] == UNBREAKABLE:
+                c["t10"][bid] = t10                # keeps the t10' of its first would-be breakage
+                self._record("unbreakable_stressed", bid, specific_energy=specific,
+                             fracture_energy=energy, t10=t10)
+                continue
+            c["kind"][bid] = BROKEN
+            event = {"specific_energy": specific, "fracture_energy": energy, "ratio": ratio,
+                     "t10": t10, "generation": int(c["generation"][bid]), "fragments": [], **extra}
+            if self.config.replacement.replace:
+                direction = (np.array([0.0, 0.0, 1.0]) if strongest is None
+                             else strongest[2] * np.array(strongest[1]))
+                progeny = self.replacer.replace(bid, t10, direction, dmin)
+                event.update(fragments=progeny.ids, family_t10=progeny.family_t10,
+                             fragment_speed_excess=progeny.speed_excess)
+                self._adopt(progeny.ids)
+                self.damping.add(progeny.ids)
+                if progeny.smallest_radius is not None:
+                    new_dt = min(new_dt, self.time_step.for_fragments(
+                        progeny.smallest_radius, O.bodies[progeny.ids[0]].material))
+            self._record("breakage", bid, **event)
+        self.time_step.lower(new_dt, self.reader.bodies_in_contact())
+        self.wall_time["replace"] += time.perf_counter() - t0
+
+    def break_body(self, body_id, ratio=1.0, direction=(0.0, 0.0, 1.0)):
+        """Break a breakable body now, as if stressed to ratio = Ek'/(m E) (its criterion's t10')
+        along `direction`. Returns the breakage event."""
+        if body_id not in self.state.tracked or self.state.table.kind_of(body_id) != "breakable":
+            raise ValueError(f"body {body_id} is not a breakable body yadebreak tracks")
+        label = self.state.table.label_of(body_id)
+        ek = self.criteria[label].force(self.state.table, body_id, ratio)
+        self._break_all([(body_id, ek, (ek, direction, 1.0))])
+        return self.events[-1]
+
+    def finish(self):
+        """Close every open stressing event as if its body had unloaded (damage with the event's
+        largest energy), for runs stopped once the loading is over. Returns how many."""
+        state = self.state
+        touching = self.reader.touching(state.open_events)
+        event_max = state.table.columns["event_max"]
+        closed = 0
+        for bid in list(state.open_events):
+            if bid in state.tracked and event_max[bid] > 0.0:
+                self._close_event(bid, touching.get(bid, ()))
+                closed += 1
+        state.open_events.clear()
+        return closed
+
+    def zero_overlaps(self):
+        """Before the InteractionLoop (see zeroing.py)."""
+        self.zeroing.apply()
+
+    # -- saving ------------------------------------------------------------------------------------
+    def to_dict(self):
+        """Everything needed to go on after O.load, JSON-able."""
+        return {"label": self.label, "options": self.config.as_options(),
+                "materials": {k: (v.source if hasattr(v, "source") else v)
+                              for k, v in self.material_names.items()},
+                "iter": O.iter, "state": self.state.to_dict(),
+                "contacts": self.reader.to_dict(), "zeroed": self.zeroing.to_list(),
+                "damped_until": self.damping.until, "fast": self.schedule.to_list()}
+
+    def restore(self, data, period):
+        """Continue from to_dict() (the state object was restored already); `period` is the
+        engine's iterPeriod as saved."""
+        table = self.state.table
+        self.smallest.rebuild((float(table.columns["radius"][i]), i) for i in self.state.tracked
+                              if table.columns["kind"][i] == BREAKABLE)
+        self.schedule.period = period
+        self.reader.restore(data["contacts"])
+        self.zeroing.restore(data["zeroed"])
+        self.damping.until = [tuple(x) for x in data["damped_until"]]
+        self.schedule.restore(data["fast"])
+        self.last_iter = data["iter"] - 1
+        for bid in table:
+            b = O.bodies[bid] if bid < len(O.bodies) else None
+            if b is not None:
+                b.breakage = BodyRow(table, bid)
+        self.state.log.rewrite()               # the log holds exactly the events of this state
+
+    def close(self):
+        self.state.log.close()

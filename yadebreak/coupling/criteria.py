@@ -1,0 +1,148 @@
+"""Breakage criteria: one class per criterion, chosen once per material (`criterion_for`), behind
+one small interface. They read and write the body columns of state.BodyTable; no yade import.
+
+    judge(table, ids, ek, specific) -> Judgement     which of the bodies read now break
+    unload(table, i) -> event fields or None          a stressing event ended without breakage
+    breakage(table, i, ek) -> (ratio, t10, extra)     the t10' of a breakage (Eq. 8 or 9.4)
+    force(table, i, ratio) -> ek                      a breakage imposed by break_body()
+    sample(rng, sizes) -> (fracture energies, extra columns)   state of a new body
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import model
+
+
+@dataclass
+class Judgement:
+    """What a criterion decided for the bodies read now (arrays aligned with the ids given).
+
+    breaks: breaks now. level, threshold: the criterion's variable and the value at which the body
+    breaks (J/kg). rising: the body's loading grew since the last read, by `rise` (J/kg, what a
+    read schedule extrapolates). jump: the rise of the criterion's variable since the last read,
+    for the warning that a read came late."""
+
+    breaks: np.ndarray
+    level: np.ndarray
+    threshold: np.ndarray
+    rising: np.ndarray
+    rise: np.ndarray
+    jump: np.ndarray
+
+
+class Tavares:
+    """The Tavares UFRJ criterion: breaks when Ek'/m > E (Eqs. 1-3); an event that ends without
+    breakage weakens the body (Eqs. 5-6); t10' from Eq. 8."""
+
+    #: bodies of this criterion are settled first in a read (see Controller._settle)
+    order = 0
+    #: steps after its creation during which a fragment counts no energy (the EDEM paper has none)
+    default_pause_steps = 0
+
+    def __init__(self, material):
+        self.material = material
+
+    def overridden(self, kappa=None, emax_ratio=None):
+        """The material with attach()'s overrides of kappa (Eq. 8) and Emax/E50 (Eq. 2)."""
+        changes = {k: v for k, v in (("kappa", kappa), ("emax_ratio", emax_ratio)) if v is not None}
+        return dataclasses.replace(self.material, **changes) if changes else self.material
+
+    def sample(self, rng, sizes):
+        return self.material.sample_fracture_energy(rng, sizes), {}
+
+    def judge(self, table, ids, ek, specific):
+        before = table.columns["specific_energy"][ids]
+        threshold = table.columns["fracture_energy"][ids]
+        rise = specific - before
+        return Judgement(breaks=specific > threshold, level=specific, threshold=threshold,
+                         rising=specific > before, rise=rise, jump=rise)
+
+    def unload(self, table, i):
+        """Eqs. 5-6 with the event's largest Ek' (breakable bodies only)."""
+        c = table.columns
+        before = float(c["fracture_energy"][i])
+        ratio = float(c["event_max"][i]) / (float(c["mass"][i]) * before)
+        if c["kind"][i] != 1:
+            return None
+        after = float(model.weakened_fracture_energy(before, ratio, self.material.gamma))
+        c["fracture_energy"][i] = after
+        c["damage"][i] = 1.0 - after / float(c["fracture_energy_initial"][i])
+        return {"fracture_energy": before, "fracture_energy_after": after, "ratio": ratio}
+
+    def breakage(self, table, i, ek):
+        mat = self.material
+        ratio = ek / (float(table.columns["mass"][i]) * float(table.columns["fracture_energy"][i]))
+        return ratio, float(model.t10(ratio, mat.A, mat.b_prime, mat.kappa)), {}
+
+    def force(self, table, i, ratio):
+        return ratio * float(table.columns["mass"][i]) * float(table.columns["fracture_energy"][i])
+
+
+class AbT10:
+    """Rocky's Ab-T10 criterion: e_cum grows by Eq. 9.2 and the body breaks when it passes the
+    threshold drawn at its creation (Eq. 9.3, kept as its fracture_energy); t10 from Eq. 9.4."""
+
+    #: Eq. 9.2 is one call for all the Ab-T10 bodies read, settled after the Tavares ones
+    order = 1
+    #: Rocky's pause after a breakage event (Rocky manual, 2.4.2)
+    default_pause_steps = 25
+
+    def __init__(self, material):
+        self.material = material
+
+    def overridden(self, kappa=None, emax_ratio=None):
+        """Ab-T10 has neither kappa nor Emax: attach()'s overrides leave it as it is."""
+        return self.material
+
+    def sample(self, rng, sizes):
+        return (self.material.sample_fracture_energy(rng, sizes),
+                {"e_min": self.material.min_energy(sizes)})
+
+    def judge(self, table, ids, ek, specific):
+        c = table.columns
+        before = c["e_prev"][ids]
+        cum_before = c["e_cum"][ids]
+        cum, top = model.ab_t10_update(specific, before, cum_before, c["e_max"][ids],
+                                       c["e_min"][ids])
+        c["e_cum"][ids], c["e_max"][ids], c["e_prev"][ids] = cum, top, specific
+        threshold = c["fracture_energy"][ids]
+        return Judgement(breaks=cum > threshold, level=cum, threshold=threshold,
+                         rising=specific > before, rise=specific - before, jump=cum - cum_before)
+
+    def unload(self, table, i):
+        """Eq. 9.2 at the unloading: e_t = 0 < e_min resets e_max; e_cum keeps the damage."""
+        c = table.columns
+        e_cum, e_max = (float(v) for v in model.ab_t10_update(
+            0.0, c["e_prev"][i].item(), c["e_cum"][i].item(), c["e_max"][i].item(),
+            c["e_min"][i].item()))
+        c["e_cum"][i], c["e_max"][i], c["e_prev"][i] = e_cum, e_max, 0.0
+        if c["kind"][i] != 1:
+            return None
+        energy = float(c["fracture_energy"][i])
+        c["damage"][i] = e_cum / energy
+        return {"e_cum": e_cum, "fracture_energy": energy,
+                "ratio": float(c["event_max"][i]) / (float(c["mass"][i]) * energy)}
+
+    def breakage(self, table, i, ek):
+        c = table.columns
+        e_cum = float(c["e_cum"][i])
+        t10 = float(self.material.t10_of_cumulative_energy(e_cum, 2.0 * float(c["radius"][i])))
+        return e_cum / float(c["fracture_energy"][i]), t10, {"e_cum": e_cum}
+
+    def force(self, table, i, ratio):
+        c = table.columns
+        c["e_cum"][i] = ratio * c["fracture_energy"][i]     # as if e_cum had reached it
+        return ratio * float(c["mass"][i]) * float(c["fracture_energy"][i])
+
+
+_CRITERIA = {"tavares": Tavares, "ab_t10": AbT10}
+
+
+def criterion_for(material):
+    """The criterion object of a breakable Material (its file's breakage.model)."""
+    return _CRITERIA[material.breakage_model or "tavares"](material)
+

@@ -1,0 +1,91 @@
+"""Materials in the scene: YADE FrictMats and the Hertz-Mindlin Ip2 from material files, and the
+mapping from YADE's material labels to yadebreak's Materials."""
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from .. import model
+from ..materials import Material, MaterialError, load_material
+from ._yade import O, wrapper
+from .config import AttachError
+from .criteria import criterion_for
+
+
+def _frict_material(mat: Material, label: str, stiffness_scale: float = 1.0):
+    contact = mat.contacts.get("self") or next(iter(mat.contacts.values()), None)
+    friction = contact.friction if contact else 0.5
+    return wrapper.FrictMat(young=mat.young_modulus * stiffness_scale, poisson=mat.poisson_ratio,
+                            density=mat.density, frictionAngle=math.atan(friction), label=label)
+
+
+def _as_material(name):
+    try:
+        return name if isinstance(name, Material) else load_material(name)
+    except MaterialError as exc:
+        raise AttachError(str(exc)) from None
+
+
+def add_materials(labels, stiffness_scale=1.0):
+    """Create one YADE FrictMat per label from material files and return the Hertz-Mindlin
+    Ip2 functor with restitution and friction per pair (paper Table 6) through MatchMaker.
+
+    labels: {"ore": "copper_ore", "steel": "steel"}. stiffness_scale multiplies every Young's
+    modulus, which keeps the ratios of Eq. 4. Returns (ip2, {label: Material}).
+    """
+    mats, ids = {}, {}
+    for label, name in labels.items():
+        mats[label] = _as_material(name)
+        ids[label] = O.materials.append(_frict_material(mats[label], label, stiffness_scale))
+    en, es, fr = [], [], []
+    for la in labels:
+        for lb in labels:
+            if ids[la] > ids[lb]:
+                continue
+            try:
+                c = mats[la].contact_with(mats[lb])
+            except KeyError as exc:
+                raise AttachError(str(exc.args[0])) from None
+            en.append((ids[la], ids[lb], c.restitution))
+            es.append((ids[la], ids[lb], c.restitution))
+            fr.append((ids[la], ids[lb], math.atan(c.friction)))
+    ip2 = wrapper.Ip2_FrictMat_FrictMat_MindlinPhys(
+        en=wrapper.MatchMaker(matches=en), es=wrapper.MatchMaker(matches=es),
+        frictAngle=wrapper.MatchMaker(matches=fr))
+    return ip2, mats
+
+
+@dataclasses.dataclass
+class SceneMaterials:
+    """The breakable materials by YADE label, and what the engine needs of every YADE material."""
+
+    by_label: dict          # YADE label -> Material (breakable)
+    label_by_id: dict       # YADE material id -> label, for breakable materials
+    stiffness_by_id: dict   # YADE material id -> Hertz stiffness Y / (1 - nu^2) (Pa; inf if rigid)
+
+
+def resolve(materials, kappa=None, emax_ratio=None):
+    """Map attach(materials=...) onto the scene's labelled YADE materials, with the options that
+    override the files (Tavares materials only)."""
+    labels = {m.label: m for m in O.materials}
+    unknown = [lab for lab in materials if lab not in labels]
+    if unknown:
+        raise AttachError(
+            f"unknown YADE material label(s) {unknown}: the scene has "
+            f"{sorted(l for l in labels if l) or 'no labelled materials'}; give each breakable "
+            f"material a label (FrictMat(..., label='ore')) and map it in attach(materials=...)")
+    by_label = {}
+    for lab, name in materials.items():
+        mat = _as_material(name)
+        if not mat.breakable:
+            raise AttachError(f"material '{mat.name}' (label '{lab}') is not breakable: map only "
+                              "breakable materials in attach(materials=...)")
+        by_label[lab] = criterion_for(mat).overridden(kappa=kappa, emax_ratio=emax_ratio)
+    stiffness, label_by_id = {}, {}
+    for m in O.materials:
+        young = getattr(m, "young", None)
+        stiffness[m.id] = (math.inf if young is None
+                           else float(model.hertz_stiffness(young, getattr(m, "poisson", 0.0))))
+        if m.label in by_label:
+            label_by_id[m.id] = m.label
+    return SceneMaterials(by_label, label_by_id, stiffness)

@@ -1,0 +1,305 @@
+"""What the engine remembers, as plain numbers: per-body state in numpy columns keyed by body id,
+the event log and the fines ledger, with to_dict / from_dict for saving with the scene. No yade
+import.
+
+Classes of a body (`kind`, also the codes of the `class` column of outputs):
+breakable (1) can break; unbreakable (2) is finer than dmin allows to break again and keeps the
+t10' of its first would-be breakage; dummy (3) stands for the unresolved fines of an event and never
+breaks; broken (4) was replaced. 0 marks ids yadebreak does not know.
+"""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+#: format of to_dict(); from_dict refuses others with a clear message
+FORMAT_VERSION = 2
+
+KINDS = ("none", "breakable", "unbreakable", "dummy", "broken")
+NONE, BREAKABLE, UNBREAKABLE, DUMMY, BROKEN = range(5)
+
+#: column -> (dtype, value of a new row); energies J/kg, event_max J, sizes m, mass kg
+_COLUMNS = {
+    "kind": (np.int8, NONE),
+    "material": (np.int16, -1),            # index into BodyTable.labels
+    "mass": (np.float64, 0.0),
+    "radius": (np.float64, 0.0),
+    "fracture_energy": (np.float64, math.inf),          # now, after damage (Tavares: E of Eq. 5)
+    "fracture_energy_initial": (np.float64, math.inf),
+    "damage": (np.float64, 0.0),                         # 1 - E / E_initial (Ab-T10: e_cum / E)
+    "specific_energy": (np.float64, 0.0),                # Ek'/m at the last read
+    "event_max": (np.float64, 0.0),                      # largest Ek' of the open event (J)
+    "t10": (np.float64, math.nan),      # unbreakable: first would-be t10'; dummy: its event's
+    "parent_size": (np.float64, math.nan),               # dummy: the parent's diameter
+    "generation": (np.int32, 0),
+    "pause_until": (np.int64, -1),      # no energy counted before this iteration (fresh fragments)
+    "e_min": (np.float64, 0.0),         # Ab-T10, Eq. 9.1 at the body's size
+    "e_cum": (np.float64, 0.0),         # Ab-T10, Eq. 9.2
+    "e_max": (np.float64, 0.0),
+    "e_prev": (np.float64, 0.0),        # Ab-T10: e_t at the previous read
+}
+
+
+class BodyTable:
+    """Per-body state in numpy columns indexed by body id (grown as bodies appear).
+
+    `table[i]` is a BodyRow: a live view of body i's row (read and write by field name).
+    It iterates like a dict {id: row} over the bodies yadebreak knows.
+    """
+
+    def __init__(self, labels=()):
+        self.labels = list(labels)            # material labels; `material` holds their index
+        self.size = 0
+        self.columns = {name: np.empty(0, dtype) for name, (dtype, _) in _COLUMNS.items()}
+        self.known = {}                       # id -> None, in the order bodies were adopted
+
+    def __getattr__(self, name):              # table.fracture_energy -> the column
+        try:
+            return self.__dict__["columns"][name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def _grow(self, top):
+        if top < self.size:
+            return
+        size = max(top + 1, 2 * self.size, 64)
+        for name, (dtype, fill) in _COLUMNS.items():
+            column = np.full(size, fill, dtype)
+            column[:self.size] = self.columns[name][:self.size]
+            self.columns[name] = column
+        self.size = size
+
+    def add(self, ids, kind, material, mass, radius, **values):
+        """New rows for bodies `ids` (arrays or scalars broadcast), other fields at their
+        defaults or from `values`."""
+        ids = np.atleast_1d(np.asarray(ids, dtype=np.int64))
+        if len(ids) == 0:
+            return
+        self._grow(int(ids.max()))
+        c = self.columns
+        for name, (_, fill) in _COLUMNS.items():
+            c[name][ids] = fill
+        c["kind"][ids] = kind
+        c["material"][ids] = self.labels.index(material) if isinstance(material, str) else material
+        c["mass"][ids] = mass
+        c["radius"][ids] = radius
+        for name, value in values.items():
+            c[name][ids] = value
+        self.known.update(dict.fromkeys(ids.tolist()))
+
+    def kind_of(self, i):
+        return KINDS[self.columns["kind"][i]] if i in self.known else "none"
+
+    def label_of(self, i):
+        return self.labels[self.columns["material"][i]]
+
+    # -- a dict of rows ----------------------------------------------------------------------
+    def __contains__(self, i):
+        return i in self.known
+
+    def __len__(self):
+        return len(self.known)
+
+    def __iter__(self):
+        return iter(self.known)
+
+    def __getitem__(self, i):
+        if i not in self.known:
+            raise KeyError(i)
+        return BodyRow(self, i)
+
+    def get(self, i, default=None):
+        return BodyRow(self, i) if i in self.known else default
+
+    def items(self):
+        return ((i, BodyRow(self, i)) for i in self.known)
+
+    def values(self):
+        return (BodyRow(self, i) for i in self.known)
+
+    def ids(self):
+        return np.fromiter(self.known, np.int64, len(self.known))
+
+    # -- saving --------------------------------------------------------------------------------
+    def to_dict(self):
+        ids = self.ids()
+        return {"labels": self.labels, "ids": ids.tolist(),
+                "columns": {name: _listed(self.columns[name][ids]) for name in _COLUMNS}}
+
+    @classmethod
+    def from_dict(cls, data):
+        table = cls(data["labels"])
+        ids = np.asarray(data["ids"], dtype=np.int64)
+        if len(ids):
+            table._grow(int(ids.max()))
+            for name, (dtype, _) in _COLUMNS.items():
+                table.columns[name][ids] = np.asarray(data["columns"][name], dtype=float).astype(dtype)
+            table.known = dict.fromkeys(ids.tolist())
+        return table
+
+
+def _listed(values):
+    """A column as a JSON-able list (inf and nan as strings JSON keeps)."""
+    return [v if math.isfinite(v) else str(v) for v in values.tolist()]
+
+
+class BodyRow:
+    """A live view of one body's row: `row.fracture_energy = 1e3` writes the column."""
+
+    __slots__ = ("_table", "id")
+
+    def __init__(self, table, i):
+        object.__setattr__(self, "_table", table)
+        object.__setattr__(self, "id", i)
+
+    def __getattr__(self, name):
+        table = self._table
+        if name == "kind":
+            return KINDS[table.columns["kind"][self.id]]
+        if name == "material":
+            return table.label_of(self.id)
+        try:
+            return table.columns[name][self.id].item()
+        except KeyError:
+            raise AttributeError(name) from None
+
+    def __setattr__(self, name, value):
+        table = self._table
+        if name == "kind":
+            value = KINDS.index(value)
+        elif name == "material":
+            value = table.labels.index(value)
+        elif name not in table.columns:
+            raise AttributeError(name)
+        table.columns[name][self.id] = value
+
+    def as_dict(self):
+        return {name: getattr(self, name) for name in _COLUMNS}
+
+    def __repr__(self):
+        return f"BodyRow({self.id}, {self.as_dict()})"
+
+
+class EventLog:
+    """Every breakage and damage event, in memory and, when a path is given, appended to a
+    JSON-lines file as it happens (flushed: a run that dies leaves its events)."""
+
+    def __init__(self, path=None, events=()):
+        self.path = None if path is None else Path(path)
+        self.events = list(events)
+        self._file = None
+
+    def start(self):
+        """Begin a new log file (attach)."""
+        if self.path is not None:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.path.write_text("")
+
+    def rewrite(self):
+        """Make the file hold exactly the events in memory (after a restore)."""
+        if self.path is not None:
+            tmp = self.path.with_suffix(".tmp")
+            tmp.write_text("".join(json.dumps(e) + "\n" for e in self.events))
+            tmp.replace(self.path)
+
+    def record(self, event):
+        self.events.append(event)
+        if self.path is not None:
+            if self._file is None:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                self._file = open(self.path, "a", buffering=1)
+            self._file.write(json.dumps(event) + "\n")
+            self._file.flush()
+
+    def close(self):
+        if self._file is not None:
+            self._file.close()
+            self._file = None
+
+
+class FinesLedger:
+    """Dummy fines kept outside the DEM (dummies="ledger"): per entry its mass (kg), the parent's
+    diameter (m), the event's t10' (%), material label and momentum (kg m/s)."""
+
+    FIELDS = ("mass", "parent_size", "t10", "material", "momentum")
+
+    def __init__(self, entries=()):
+        self.entries = [dict(e) for e in entries]
+
+    def add(self, mass, parent_size, t10, material, momentum):
+        self.entries.append({"mass": float(mass), "parent_size": float(parent_size),
+                             "t10": float(t10), "material": material,
+                             "momentum": [float(p) for p in momentum]})
+
+    def __len__(self):
+        return len(self.entries)
+
+    def __iter__(self):
+        return iter(self.entries)
+
+    def total_mass(self):
+        return sum(e["mass"] for e in self.entries)
+
+    def kinetic_energy(self):
+        """Kinetic energy (J) the fines carry: |p|^2 / 2m summed."""
+        return sum(0.5 * sum(p * p for p in e["momentum"]) / e["mass"] for e in self.entries)
+
+    def to_list(self):
+        return [dict(e) for e in self.entries]
+
+
+def check_format(data):
+    """Refuse saved state of another format version, saying which."""
+    version = data.get("format_version", 1)
+    if version != FORMAT_VERSION:
+        raise ValueError(f"saved yadebreak state has format version {version}; this yadebreak "
+                         f"reads version {FORMAT_VERSION}: run the scene again from its start")
+
+
+class EngineState:
+    """Everything an engine knows about its bodies, as plain numbers: the body table, which
+    bodies are tracked (breakable, or unbreakable awaiting their t10') and which have an open
+    stressing event, the event log, the fines ledger, the random stream, the top size (m) and
+    the warnings given."""
+
+    def __init__(self, labels, seed, event_log=None):
+        self.table = BodyTable(labels)
+        self.tracked = set()
+        self.open_events = set()
+        self.log = EventLog(event_log)
+        self.ledger = FinesLedger()
+        self.rng = np.random.default_rng(seed)
+        self.top_size = 0.0
+        self.warned = set()
+
+    def total_mass(self):
+        """Mass (kg) of every body known, fragments and ledger fines included, broken parents
+        excluded (summed in the order bodies appeared)."""
+        ids = self.table.ids()
+        keep = self.table.columns["kind"][ids] != BROKEN
+        return float(sum(self.table.columns["mass"][ids][keep].tolist()) + self.ledger.total_mass())
+
+    def to_dict(self):
+        return {"format_version": FORMAT_VERSION, "table": self.table.to_dict(),
+                "tracked": sorted(self.tracked), "events": self.log.events,
+                "ledger": self.ledger.to_list(), "rng": self.rng.bit_generator.state,
+                "top_size": self.top_size, "warned": sorted(self.warned)}
+
+    @classmethod
+    def from_dict(cls, data, event_log=None):
+        check_format(data)
+        self = cls(data["table"]["labels"], 0, event_log)
+        self.table = BodyTable.from_dict(data["table"])
+        self.tracked = set(data["tracked"])
+        # open events are those with an energy recorded (built in id order, as at any restore)
+        event_max = self.table.columns["event_max"]
+        self.open_events = {i for i in data["tracked"] if event_max[i] > 0.0}
+        self.log = EventLog(event_log, data["events"])
+        self.ledger = FinesLedger(data["ledger"])
+        self.rng.bit_generator.state = data["rng"]
+        self.top_size = data["top_size"]
+        self.warned = set(data["warned"])
+        return self
