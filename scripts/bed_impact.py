@@ -22,5 +22,6 @@ args = script_params(dict(material="copper_ore", size=5.5e-3, rings=3, layers=1,
                           checkpoint_every=60.0, resume=False, out="out/bed_impact"), __doc__)
 
 from yadebreak import bed  # noqa: E402
+from yadebreak.scriptargs import run_script  # noqa: E402
 
-brk, result = bed.run(args)
+brk, result = run_script(bed.run, args)

@@ -31,74 +31,80 @@ args = script_params(dict(material="copper_ore", size=37.5e-3, particles=100, im
 
 from yade import O  # noqa: E402
 from yadebreak import coupling, scenes  # noqa: E402
+from yadebreak.scriptargs import ScriptError, run_script  # noqa: E402
 
-mat = load_material(args.material)
-if args.gamma > 0:
+
+def main(args):
+    mat = load_material(args.material)
+    if args.gamma > 0:
+        if mat.is_ab_t10:
+            raise ScriptError(f"--gamma applies to Tavares materials; {mat.name} uses Ab-T10")
+        mat = dataclasses.replace(mat, gamma=args.gamma)
+    share = mat.energy_partition(load_material(args.target))
+    speed = float(np.sqrt(2 * args.energy))
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.time()
+    checkpoint = out / "checkpoint.yade.gz"
+    if args.resume:
+        brk, loop = coupling.load_checkpoint(checkpoint)
+        check_resume_arguments(loop["arguments"], args, checkpoint)
+        ids, alive, fractions = loop["ids"], loop["alive"], loop["fractions"]
+        home = {int(i): tuple(p) for i, p in loop["home"].items()}
+        progress(f"resumed from {checkpoint} after impact {len(fractions)}")
+    else:
+        brk, ids = scenes.impact_scene(mat, args.size, [speed] * args.particles, target=args.target,
+                                       seed=args.seed, replace=False,
+                                       time_step_fraction=args.time_step_fraction,
+                                       event_log=str(out / "events.jsonl"))
+        home = {i: tuple(O.bodies[i].state.pos) for i in ids}
+        alive = list(ids)
+        fractions = []
+    for k in range(len(fractions), args.impacts):
+        alive = scenes.impact_again(brk, alive, home, speed)   # broken particles leave the test
+        fractions.append(1 - len(alive) / args.particles)
+        progress(f"impact {k + 1}: {100 * fractions[-1]:.0f} % broken, {time.time() - start:.1f} s")
+        coupling.save_checkpoint(checkpoint, {
+            "ids": ids, "alive": alive, "fractions": fractions, "home": home,
+            "arguments": resume_arguments(args)})
+        stop_if_asked(args, len(fractions))
+
     if mat.is_ab_t10:
-        sys.exit(f"--gamma applies to Tavares materials; {mat.name} uses Ab-T10")
-    mat = dataclasses.replace(mat, gamma=args.gamma)
-share = mat.energy_partition(load_material(args.target))
-speed = float(np.sqrt(2 * args.energy))
-out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
-start = time.time()
-checkpoint = out / "checkpoint.yade.gz"
-if args.resume:
-    brk, loop = coupling.load_checkpoint(checkpoint)
-    check_resume_arguments(loop["arguments"], args, checkpoint)
-    ids, alive, fractions = loop["ids"], loop["alive"], loop["fractions"]
-    home = {int(i): tuple(p) for i, p in loop["home"].items()}
-    progress(f"resumed from {checkpoint} after impact {len(fractions)}")
-else:
-    brk, ids = scenes.impact_scene(mat, args.size, [speed] * args.particles, target=args.target,
-                                   seed=args.seed, replace=False,
-                                   time_step_fraction=args.time_step_fraction,
-                                   event_log=str(out / "events.jsonl"))
-    home = {i: tuple(O.bodies[i].state.pos) for i in ids}
-    alive = list(ids)
-    fractions = []
-for k in range(len(fractions), args.impacts):
-    alive = scenes.impact_again(brk, alive, home, speed)   # broken particles leave the test
-    fractions.append(1 - len(alive) / args.particles)
-    progress(f"impact {k + 1}: {100 * fractions[-1]:.0f} % broken, {time.time() - start:.1f} s")
-    coupling.save_checkpoint(checkpoint, {
-        "ids": ids, "alive": alive, "fractions": fractions, "home": home,
-        "arguments": resume_arguments(args)})
-    stop_if_asked(args, len(fractions))
+        model_fractions = model.ab_t10_repeated_broken_fraction(
+            share * args.energy, args.size, float(mat.min_energy(args.size)), mat.selection,
+            mat.size_ref, args.impacts)
+        model_label = "model P(e_cum), e_cum = k (e Ek/mp - e_min) (Eqs. 9.1-9.3)"
+    else:
+        e50 = float(mat.median_fracture_energy(args.size))
+        model_fractions = model.repeated_impact_broken_fraction(share * args.energy, e50, mat.sigma,
+                                                                mat.emax_ratio, mat.gamma, args.impacts)
+        model_label = f"model (Eqs. 1-6), gamma = {mat.gamma:g}"
+    absorbed = [e["specific_energy"] for e in brk.events if e["kind"] == "damage"]
+    summary = {"material": mat.name, "model": mat.breakage_model, "size": args.size,
+               "energy": args.energy, "gamma": mat.gamma,
+               "particles": args.particles, "share_e": share,
+               "broken_fraction": fractions, "model_broken_fraction": model_fractions.tolist(),
+               "mean_absorbed_specific_energy": float(np.mean(absorbed)) if absorbed else None,
+               "expected_absorbed_specific_energy": share * args.energy,
+               "runtime_s": time.time() - start}
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
 
-if mat.is_ab_t10:
-    model_fractions = model.ab_t10_repeated_broken_fraction(
-        share * args.energy, args.size, float(mat.min_energy(args.size)), mat.selection,
-        mat.size_ref, args.impacts)
-    model_label = "model P(e_cum), e_cum = k (e Ek/mp - e_min) (Eqs. 9.1-9.3)"
-else:
-    e50 = float(mat.median_fracture_energy(args.size))
-    model_fractions = model.repeated_impact_broken_fraction(share * args.energy, e50, mat.sigma,
-                                                            mat.emax_ratio, mat.gamma, args.impacts)
-    model_label = f"model (Eqs. 1-6), gamma = {mat.gamma:g}"
-absorbed = [e["specific_energy"] for e in brk.events if e["kind"] == "damage"]
-summary = {"material": mat.name, "model": mat.breakage_model, "size": args.size,
-           "energy": args.energy, "gamma": mat.gamma,
-           "particles": args.particles, "share_e": share,
-           "broken_fraction": fractions, "model_broken_fraction": model_fractions.tolist(),
-           "mean_absorbed_specific_energy": float(np.mean(absorbed)) if absorbed else None,
-           "expected_absorbed_specific_energy": share * args.energy,
-           "runtime_s": time.time() - start}
-(out / "summary.json").write_text(json.dumps(summary, indent=2))
+    import matplotlib  # noqa: E402
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: E402
 
-import matplotlib  # noqa: E402
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+    n = np.arange(1, args.impacts + 1)
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(n, 100 * model_fractions, "k-", label=model_label)
+    sigma = np.sqrt(model_fractions * (1 - model_fractions) / args.particles)
+    ax.errorbar(n, 100 * np.array(fractions), yerr=300 * sigma, fmt="o", c="C3",
+                label="simulation (3 sigma of the model)")
+    ax.set(xlabel="number of impacts", ylabel="broken (%)",
+           title=f"{mat.name}, {1e3 * args.size:g} mm at {args.energy:g} J/kg on {args.target}")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out / "repeated_impact.png", dpi=110)
+    progress(f"wrote {out / 'summary.json'} and {out / 'repeated_impact.png'}")
 
-n = np.arange(1, args.impacts + 1)
-fig, ax = plt.subplots(figsize=(6, 4.5))
-ax.plot(n, 100 * model_fractions, "k-", label=model_label)
-sigma = np.sqrt(model_fractions * (1 - model_fractions) / args.particles)
-ax.errorbar(n, 100 * np.array(fractions), yerr=300 * sigma, fmt="o", c="C3",
-            label="simulation (3 sigma of the model)")
-ax.set(xlabel="number of impacts", ylabel="broken (%)",
-       title=f"{mat.name}, {1e3 * args.size:g} mm at {args.energy:g} J/kg on {args.target}")
-ax.legend()
-fig.tight_layout()
-fig.savefig(out / "repeated_impact.png", dpi=110)
-progress(f"wrote {out / 'summary.json'} and {out / 'repeated_impact.png'}")
+
+run_script(main, args)

@@ -27,40 +27,46 @@ args = script_params(dict(material="copper_ore", size=5.5e-3, particles=250, see
                           stop_after=0), __doc__)
 
 from yadebreak import scenes  # noqa: E402
+from yadebreak.scriptargs import run_script  # noqa: E402
 
-mat, target = load_material(args.material), load_material(args.target)
-share = mat.energy_partition(target)
-out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
-start = time.time()
-energies = [float(e) for e in args.energies.split(",")]
-partial = PartialResults(out, args)
-for k, energy in partial.todo(energies):
-    speed = float(np.sqrt(2 * energy))
-    brk, ids = scenes.impact_scene(args.material, args.size, [speed] * args.particles,
-                                   target=args.target, seed=args.seed + k, replace=args.replace,
-                                   time_step_fraction=args.time_step_fraction,
-                                   event_log=str(out / f"events_{energy:g}.jsonl"))
-    initial_mass = brk.total_mass()
-    steps = scenes.run_until_rebound(ids)
-    result = reports.breakage_result(brk, ids, mat, args.size, energy, target)
-    intact = [e for e in reports.first_events(brk.events, ids).values() if e["kind"] == "damage"]
-    result.update({
-        "speed": speed, "half_v_squared": energy, "steps": steps,
-        "mean_specific_energy_measured": (float(np.mean([e["specific_energy"] / share
-                                                         for e in intact])) if intact else None),
-        "mass_relative_error": abs(brk.total_mass() - initial_mass) / initial_mass})
-    partial.add(energy, result)
-    progress(f"{energy:g} J/kg: {100 * result['broken_fraction']:.1f} % broken (model "
-             f"{100 * result['model_probability']:.1f} %), {steps} steps, "
-             f"{time.time() - start:.1f} s")
 
-results = partial.ordered(energies)
-summary = {"material": mat.name, "size": args.size, "target": args.target, "share_e": share,
-           "results": results, "runtime_s": time.time() - start}
-(out / "summary.json").write_text(json.dumps(summary, indent=2))
+def main(args):
+    mat, target = load_material(args.material), load_material(args.target)
+    share = mat.energy_partition(target)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.time()
+    energies = [float(e) for e in args.energies.split(",")]
+    partial = PartialResults(out, args)
+    for k, energy in partial.todo(energies):
+        speed = float(np.sqrt(2 * energy))
+        brk, ids = scenes.impact_scene(args.material, args.size, [speed] * args.particles,
+                                       target=args.target, seed=args.seed + k, replace=args.replace,
+                                       time_step_fraction=args.time_step_fraction,
+                                       event_log=str(out / f"events_{energy:g}.jsonl"))
+        initial_mass = brk.total_mass()
+        steps = scenes.run_until_rebound(ids)
+        result = reports.breakage_result(brk, ids, mat, args.size, energy, target)
+        intact = [e for e in reports.first_events(brk.events, ids).values() if e["kind"] == "damage"]
+        result.update({
+            "speed": speed, "half_v_squared": energy, "steps": steps,
+            "mean_specific_energy_measured": (float(np.mean([e["specific_energy"] / share
+                                                             for e in intact])) if intact else None),
+            "mass_relative_error": abs(brk.total_mass() - initial_mass) / initial_mass})
+        partial.add(energy, result)
+        progress(f"{energy:g} J/kg: {100 * result['broken_fraction']:.1f} % broken (model "
+                 f"{100 * result['model_probability']:.1f} %), {steps} steps, "
+                 f"{time.time() - start:.1f} s")
 
-reports.plot_breakage(results, mat, args.size, target,
-                      f"{mat.name}, {1e3 * args.size:g} mm on {args.target}",
-                      out / "single_impact.png")
-progress(f"wrote {out / 'summary.json'} and {out / 'single_impact.png'}")
+    results = partial.ordered(energies)
+    summary = {"material": mat.name, "size": args.size, "target": args.target, "share_e": share,
+               "results": results, "runtime_s": time.time() - start}
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+
+    reports.plot_breakage(results, mat, args.size, target,
+                          f"{mat.name}, {1e3 * args.size:g} mm on {args.target}",
+                          out / "single_impact.png")
+    progress(f"wrote {out / 'summary.json'} and {out / 'single_impact.png'}")
+
+
+run_script(main, args)

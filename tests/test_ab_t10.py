@@ -1,4 +1,4 @@
-"""The Ab-T10 criterion (MODEL.md Section 9): model functions on scripted histories (no YADE),
+"""The Ab-T10 criterion (docs/model.md Section 9): model functions on scripted histories (no YADE),
 material files, and single and repeated impacts in YADE against P(e_cum)."""
 import math
 

@@ -82,7 +82,7 @@ def _events_for(seed, steps_before=None, tmp_path=None, material="limestone", re
         coupling.forget()                  # as in a new process
         O.load(path)
     O.run(1500 - (steps_before or 0), True)
-    brk = coupling.controller()
+    brk = coupling.controller_of()
     return [(e["kind"], e["id"], e["iter"], round(e["specific_energy"], 9),
              round(e["fracture_energy"], 9)) for e in brk.events]
 

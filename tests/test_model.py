@@ -31,7 +31,7 @@ def test_cdf_is_zero_below_and_one_at_truncation():
 
 
 def test_fig1_check_values():
-    # MODEL.md: E50 = 347.3 J/kg; u = 0.71 -> 534.1 J/kg and the 35.5th percentile 258.0 J/kg;
+    # docs/model.md: E50 = 347.3 J/kg; u = 0.71 -> 534.1 J/kg and the 35.5th percentile 258.0 J/kg;
     # sigma 0.8 / Emax/E50 100 within 0.8 %, sigma 0.790 / 222 "exactly" (to the printed digits).
     e = model.fracture_energy_ppf([0.71, 0.355], 347.3, 0.80, 100.0)
     np.testing.assert_allclose(e, [534.1, 258.0], rtol=0.008)
@@ -99,13 +99,13 @@ def test_t10_increasing_and_bounded():
 
 
 def test_eq10_table1_at_t10_3_percent():
-    # MODEL.md: Table 1 gives t1.2 61.1, t1.5 36.1, t2 17.6, t4 5.70 % at t10 = 3 %.
+    # docs/model.md: Table 1 gives t1.2 61.1, t1.5 36.1, t2 17.6, t4 5.70 % at t10 = 3 %.
     t = model.t_markers(3.0, T1)[:4]
     np.testing.assert_allclose(t, [61.1, 36.1, 17.6, 5.70], atol=0.05)
 
 
 def test_eq10_against_the_paper_table2_family_mixture():
-    # The probability-weighted families of Table 2, read at the class boundaries as MODEL.md does
+    # The probability-weighted families of Table 2, read at the class boundaries as docs/model.md does
     # (59.5, 40.0, 17.9, 5.72 %), agree with Eq. 10 to within 4 %: the confirmation of Eq. 10.
     from yadebreak import families
     counts = np.array([[0, 1, 0, 1, 0, 1, 1, 0, 1, 1, 5], [0, 1, 0, 0, 2, 0, 1, 1, 2, 1, 5],

@@ -92,6 +92,22 @@ def list_materials(_args):
         print(f"{name:12s} {'breakable' if mat.breakable else 'non-breakable':14s} {mat.description}")
 
 
+def print_options(_args):
+    """The engine's options as Markdown (docs/options.md is this output)."""
+    from .coupling.config import options_markdown
+    print(OPTIONS_HEADER + options_markdown())
+
+
+OPTIONS_HEADER = """# Options of `yadebreak.attach()`
+
+`attach(materials, seed=0, label="yadebreak", **options)` checks every option against this table
+before anything changes in the scene: a bad value raises `AttachError` naming the option, the
+value, the accepted range and the unit. Written by `python3 -m yadebreak options` from
+`yadebreak/coupling/config.py` (a test keeps the two the same).
+
+"""
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m yadebreak")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -107,6 +123,8 @@ def main(argv=None):
     p.set_defaults(func=plot_families)
     p = sub.add_parser("materials", help="list the material library")
     p.set_defaults(func=list_materials)
+    p = sub.add_parser("options", help="the engine's options as Markdown (docs/options.md)")
+    p.set_defaults(func=print_options)
     args = parser.parse_args(argv)
     try:
         args.func(args)

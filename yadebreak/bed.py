@@ -75,11 +75,8 @@ def _resume(path):
     return brk, info, data["loop"]
 
 
-def run(args, quiet=False):
-    """Build, run and report one bed impact. Returns (controller, summary dict)."""
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    energy = args.energy if args.speed <= 0 else 0.5 * scenes.BALL_MASS * args.speed ** 2
+def _options(args, out):
+    """attach() options from the script's arguments."""
     read_period = (args.read_period if args.read_period in ("auto", "fast")
                    else int(args.read_period))
     options = dict(time_step_fraction=args.time_step_fraction, dummies=args.dummies,
@@ -88,20 +85,26 @@ def run(args, quiet=False):
         options["dmin"] = args.dmin
     if args.global_damping > 0:
         options.update(global_damping=args.global_damping, global_damping_time=5e-4)
-    start = time.time()
-    say = (lambda m: None) if quiet else progress
+    return options
+
+
+def _start(args, out, energy, say):
+    """The scene, new or from the checkpoint (--resume 1): (controller, info, loop state)."""
     checkpoint = out / "checkpoint.yade.gz"
     if getattr(args, "resume", False):
         brk, info, loop = _resume(checkpoint)
         say(f"resumed from {checkpoint} at t = {1e3 * O.time:.3f} ms, iteration {O.iter}")
-    else:
-        brk, info = scenes.bed_impact_scene(args.material, args.size, args.rings, args.layers,
-                                            energy, args.seed, **options)
-        loop = {"touched": None, "turned": None, "initial_mass": brk.total_mass()}
-        say(f"{len(info['particles'])} particles of {args.material} ({1e3 * args.size:g} mm), "
-            f"{args.layers} layer(s); ball at {info['speed']:.3f} m/s ({energy:g} J); "
-            f"dt {O.dt:.3g} s")
-    initial_mass = loop["initial_mass"]
+        return brk, info, loop
+    brk, info = scenes.bed_impact_scene(args.material, args.size, args.rings, args.layers,
+                                        energy, args.seed, **_options(args, out))
+    say(f"{len(info['particles'])} particles of {args.material} ({1e3 * args.size:g} mm), "
+        f"{args.layers} layer(s); ball at {info['speed']:.3f} m/s ({energy:g} J); dt {O.dt:.3g} s")
+    return brk, info, {"touched": None, "turned": None, "initial_mass": brk.total_mass()}
+
+
+def _impact(brk, info, loop, args, out, start, say):
+    """Run until the ball has turned plus TAIL of unloading (or max_time), with progress lines
+    and checkpoints. False if the run stopped early on purpose (--stop-after, tests)."""
     ball = O.bodies[info["ball"]]
     v0 = info["speed"]
     every = getattr(args, "checkpoint_every", 60.0)
@@ -119,16 +122,16 @@ def run(args, quiet=False):
         # breakage happens while loading: after the turn, a short unloading, then open events
         # are closed with their largest energy (brk.finish)
         if turned is not None and O.time >= turned + TAIL:
-            break
+            return True
         if O.time > args.max_time:
             say(f"stopped at max_time = {args.max_time} s of simulated time")
-            break
+            return True
         now = time.time()
         if every >= 0 and now - last_checkpoint >= every:
-            _checkpoint(checkpoint, info, loop)   # a run that dies goes on with --resume 1
+            _checkpoint(out / "checkpoint.yade.gz", info, loop)   # --resume 1 goes on from here
             last_checkpoint = now
         if stop_after and O.time >= stop_after:
-            return brk, None                      # (tests) as if the run had died here
+            return False                          # (tests) as if the run had died here
         if now - last_report > 5.0:
             done = 0.0 if touched is None else (0.5 * (1 - max(-vz, 0.0) / v0) if turned is None
                                                 else 0.5 + 0.5 * (O.time - turned) / TAIL)
@@ -137,16 +140,37 @@ def run(args, quiet=False):
                 f"{sum(1 for b in O.bodies if b is not None)} bodies, ball {vz:+.3f} m/s, "
                 f"wall {now - start:.0f} s, about {eta:.0f} s left")
             last_report = now
-    brk.finish()
-    runtime = time.time() - start
 
+
+def run(args, quiet=False):
+    """Build, run and report one bed impact. Returns (controller, summary dict)."""
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    energy = args.energy if args.speed <= 0 else 0.5 * scenes.BALL_MASS * args.speed ** 2
+    start = time.time()
+    say = (lambda m: None) if quiet else progress
+    brk, info, loop = _start(args, out, energy, say)
+    if not _impact(brk, info, loop, args, out, start, say):
+        return brk, None
+    brk.finish()
+    summary = _report(brk, info, loop, args, out, energy, time.time() - start)
+    say(f"done in {summary['runtime_s']:.1f} s: {summary['breakage_events']} breakages, broken "
+        f"mass {1e3 * summary['broken_mass']:.3f} g ({100 * summary['broken_mass_fraction']:.1f} "
+        f"%), capture radius {1e3 * summary['capture_radius']:.1f} mm; outputs in {out}")
+    return brk, summary
+
+
+def _report(brk, info, loop, args, out, energy, runtime):
+    """summary.json, the size distribution (CSV and plot), the top view and the VTK file."""
+    initial_mass = loop["initial_mass"]
     sieves = np.geomspace(1e-5, 2 * args.size, 80)
     sd = brk.size_distribution(sieves)
     broken_mass = float(brk.size_distribution([FEED_LOWER_SIEVE]).passing_mass[0])
     fates = _fates(brk, info["particles"])
     summary = {
         "material": args.material, "size": args.size, "rings": args.rings, "layers": args.layers,
-        "energy": energy, "ball_speed": v0, "seed": args.seed, "particles": len(info["particles"]),
+        "energy": energy, "ball_speed": info["speed"], "seed": args.seed,
+        "particles": len(info["particles"]),
         "initial_mass": initial_mass, "final_mass": brk.total_mass(),
         "mass_relative_error": abs(brk.total_mass() - initial_mass) / initial_mass,
         "broken_mass": broken_mass, "broken_mass_fraction": broken_mass / initial_mass,
@@ -164,10 +188,7 @@ def run(args, quiet=False):
         w.writerows(zip(sd.sizes, sd.passing_percent))
     write_vtk(out / "bodies.vtk", brk)
     _plots(out, sd, info, fates, summary)
-    say(f"done in {runtime:.1f} s: {summary['breakage_events']} breakages, broken mass "
-        f"{1e3 * broken_mass:.3f} g ({100 * summary['broken_mass_fraction']:.1f} %), capture "
-        f"radius {1e3 * summary['capture_radius']:.1f} mm; outputs in {out}")
-    return brk, summary
+    return summary
 
 
 def _plots(out, sd, info, fates, summary):

@@ -1,4 +1,4 @@
-"""Progeny families for stochastic sphere replacement (MODEL.md Section 6; Tavares and Chagas).
+"""Progeny families for stochastic sphere replacement (docs/model.md Section 6; Tavares and Chagas).
 
 A broken sphere is replaced by one family of spheres drawn at random from a small set prepared
 for the t10' of the event. Convention of the paper's Table 2: relative sizes x_k = 2^(-k/4),
@@ -26,6 +26,7 @@ import hashlib
 import json
 import os
 import time
+import zipfile
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -318,8 +319,8 @@ def _table_cached(beta_key, t10_min, t10_max, seed):
                 sets.append(FamilySet(float(t), RELATIVE_SIZES.copy(), data[f"counts{i}"],
                                       data[f"prob{i}"], eq10_class_fractions(t, beta_params)))
             return FamilyTable(beta_params, t10_min, t10_max, seed, sets=sets)
-        except Exception:                      # a damaged cache file is rebuilt, never trusted
-            pass
+        except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile):
+            pass                               # a damaged cache file is rebuilt, never trusted
     table = FamilyTable(beta_params, t10_min, t10_max, seed)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

@@ -1,4 +1,8 @@
-"""Material library: TOML files in materials/, read with tomllib, validated and converted to SI once.
+"""Material library: TOML files, read with tomllib, validated and converted to SI once.
+
+A material name ('copper_ore') is looked for in the folders of material_search_path(): those
+in $YADEBREAK_MATERIALS, then the working folder's materials/, then the files shipped with the
+package (yadebreak/data/materials, also reached as materials/ at the top of the repository).
 
 A file states its units as the paper prints them (mm, GPa, %); the Material object holds SI values
 (m, Pa) except t10-related percentages (A), which stay in percent like t10 itself.
@@ -7,6 +11,7 @@ Never imports yade.
 from __future__ import annotations
 
 import math
+import os
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,7 +22,8 @@ import numpy as np
 
 from . import model
 
-MATERIALS_DIR = Path(__file__).resolve().parent.parent / "materials"
+#: the materials shipped with the package
+MATERIALS_DIR = Path(__file__).resolve().parent / "data" / "materials"
 
 _N_KEYS = {"1.2": 1.2, "1.5": 1.5, "2": 2.0, "4": 4.0, "25": 25.0, "50": 50.0, "75": 75.0}
 
@@ -68,7 +74,7 @@ class Material:
     device_stiffness: float = model.DEVICE_STIFFNESS_STEEL
     beta_params: Mapping[float, tuple] | None = None
     beta_source: str | None = None
-    # Ab-T10 parameters (MODEL.md Section 9; None unless breakage_model == "ab_t10")
+    # Ab-T10 parameters (docs/model.md Section 9; None unless breakage_model == "ab_t10")
     e_min_ref: float | None = None       # J/kg, at size_ref
     size_ref: float | None = None        # m
     selection: float | None = None       # S, kg/J
@@ -296,14 +302,34 @@ def _parse(doc, source):
     if contact_like is not None and not isinstance(contact_like, str):
         problems.append("contact_like: must be the name of another material")
         contact_like = None
+    values = _parse_elastic(doc, problems)
+    contacts = _parse_contacts(doc, contact_like, problems)
+    model_name, beta_params, beta_source = None, None, None
+    if breakable:
+        model_name, beta_params, beta_source = _parse_breakage(doc, values, problems)
+    elif "breakage" in doc:
+        problems.append("breakage: given for a material with breakable = false")
+    if problems:
+        raise MaterialError(source, problems)
+    return Material(name=name, source=str(source), description=description, breakable=breakable,
+                    contacts=MappingProxyType(contacts), contact_like=contact_like,
+                    breakage_model=model_name, beta_params=beta_params, beta_source=beta_source,
+                    **values)
 
+
+def _parse_elastic(doc, problems):
+    """[elastic]: {key: SI value or None}."""
     elastic = _read_table(doc, "elastic", "", problems)
     _check_keys(elastic, {k[0] for k in _ELASTIC}, "elastic", problems)
     values = {}
     for key, lo, lo_inc, hi, hi_inc, unit, factor in _ELASTIC:
         v = _number(elastic, key, "elastic", problems, lo, lo_inc, hi, hi_inc, unit)
         values[key] = None if v is None else v * factor
+    return values
 
+
+def _parse_contacts(doc, contact_like, problems):
+    """[contact.<other>] tables: {other: ContactParams}."""
     contacts = {}
     contact_doc = _read_table(doc, "contact", "", problems, required=contact_like is None)
     for other, table in contact_doc.items():
@@ -316,76 +342,92 @@ def _parse(doc, source):
                for k, lo, li, hi, hi_i, u, _ in _CONTACT]
         if None not in got:
             contacts[other] = ContactParams(*got)
-
-    breakage = _read_table(doc, "breakage", "", problems, required=breakable)
-    model_name = None
-    beta_params = None
-    beta_source = None
-    if breakable:
-        model_name = breakage.get("model", "tavares")
-        if model_name not in _MODELS:
-            problems.append(f"breakage.model = {model_name!r}: accepted 'tavares' (the default) "
-                            "or 'ab_t10'")
-            model_name = "tavares"
-        fields, defaults = _MODELS[model_name]
-        allowed = {k[0] for k in fields} | {"model", "beta", "beta_source"}
-        if model_name == "tavares":
-            allowed.add("device_stiffness")
-        _check_keys(breakage, allowed, "breakage", problems)
-        for key, lo, lo_inc, hi, hi_inc, unit, factor in fields:
-            v = _number(breakage, key, "breakage", problems, lo, lo_inc, hi, hi_inc, unit,
-                        default=defaults.get(key))
-            values[key] = None if v is None else v * factor
-        if model_name == "tavares":
-            dev = _number(breakage, "device_stiffness", "breakage", problems, 0.0, False, 1500.0,
-                          True, "GPa", required=False, default=model.DEVICE_STIFFNESS_STEEL / 1e9)
-            values["device_stiffness"] = None if dev is None else dev * 1e9
-        beta_source = breakage.get("beta_source", "material")
-        if beta_source not in ("material", "table1"):
-            problems.append(f"breakage.beta_source = {beta_source!r}: accepted 'material' (the "
-                            "[breakage.beta] table) or 'table1' (the paper's Table 1 average)")
-        if beta_source == "table1":
-            if "beta" in breakage:
-                problems.append("breakage.beta: given although beta_source = 'table1'; remove one")
-            beta_params = model.TABLE1_BETA_PARAMS
-        else:
-            beta_table = _read_table(breakage, "beta", "breakage.", problems)
-            _check_keys(beta_table, set(_N_KEYS), "breakage.beta", problems)
-            parsed = {}
-            for key, n in _N_KEYS.items():
-                pair = beta_table.get(key)
-                where = f'breakage.beta."{key}"'
-                if pair is None:
-                    if beta_table:
-                        problems.append(f"{where}: missing ([alpha, beta] for n = {key})")
-                    continue
-                if (not isinstance(pair, list) or len(pair) != 2
-                        or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in pair)):
-                    problems.append(f"{where}: must be a pair of numbers [alpha, beta], got {pair!r}")
-                    continue
-                if not all(math.isfinite(v) and v > 0 for v in pair):
-                    problems.append(f"{where} = {pair}: alpha and beta must be > 0, accepted range "
-                                    "(0, inf)")
-                    continue
-                parsed[n] = (float(pair[0]), float(pair[1]))
-            beta_params = MappingProxyType(parsed) if len(parsed) == 7 else None
-    elif "breakage" in doc:
-        problems.append("breakage: given for a material with breakable = false")
-
-    if problems:
-        raise MaterialError(source, problems)
-    return Material(name=name, source=str(source), description=description, breakable=breakable,
-                    contacts=MappingProxyType(contacts), contact_like=contact_like,
-                    breakage_model=model_name, beta_params=beta_params, beta_source=beta_source, **values)
+    return contacts
 
 
-def available_materials(directory=MATERIALS_DIR):
-    """Names of the material files shipped in `directory`."""
-    return sorted(p.stem for p in Path(directory).glob("*.toml"))
+def _parse_breakage(doc, values, problems):
+    """[breakage] of a breakable material into `values` (SI); returns (model name, beta
+    parameters, beta source)."""
+    breakage = _read_table(doc, "breakage", "", problems)
+    model_name = breakage.get("model", "tavares")
+    if model_name not in _MODELS:
+        problems.append(f"breakage.model = {model_name!r}: accepted 'tavares' (the default) "
+                        "or 'ab_t10'")
+        model_name = "tavares"
+    fields, defaults = _MODELS[model_name]
+    allowed = {k[0] for k in fields} | {"model", "beta", "beta_source"}
+    if model_name == "tavares":
+        allowed.add("device_stiffness")
+    _check_keys(breakage, allowed, "breakage", problems)
+    for key, lo, lo_inc, hi, hi_inc, unit, factor in fields:
+        v = _number(breakage, key, "breakage", problems, lo, lo_inc, hi, hi_inc, unit,
+                    default=defaults.get(key))
+        values[key] = None if v is None else v * factor
+    if model_name == "tavares":
+        dev = _number(breakage, "device_stiffness", "breakage", problems, 0.0, False, 1500.0,
+                      True, "GPa", required=False, default=model.DEVICE_STIFFNESS_STEEL / 1e9)
+        values["device_stiffness"] = None if dev is None else dev * 1e9
+    beta_source = breakage.get("beta_source", "material")
+    if beta_source not in ("material", "table1"):
+        problems.append(f"breakage.beta_source = {beta_source!r}: accepted 'material' (the "
+                        "[breakage.beta] table) or 'table1' (the paper's Table 1 average)")
+    if beta_source == "table1":
+        if "beta" in breakage:
+            problems.append("breakage.beta: given although beta_source = 'table1'; remove one")
+        return model_name, model.TABLE1_BETA_PARAMS, beta_source
+    return model_name, _parse_beta(_read_table(breakage, "beta", "breakage.", problems),
+                                   problems), beta_source
+
+
+def _parse_beta(beta_table, problems):
+    """[breakage.beta]: {n: (alpha, beta)} for the seven n of Eq. 10, or None if incomplete."""
+    _check_keys(beta_table, set(_N_KEYS), "breakage.beta", problems)
+    parsed = {}
+    for key, n in _N_KEYS.items():
+        pair = beta_table.get(key)
+        where = f'breakage.beta."{key}"'
+        if pair is None:
+            if beta_table:
+                problems.append(f"{where}: missing ([alpha, beta] for n = {key})")
+            continue
+        if (not isinstance(pair, list) or len(pair) != 2
+                or any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in pair)):
+            problems.append(f"{where}: must be a pair of numbers [alpha, beta], got {pair!r}")
+            continue
+        if not all(math.isfinite(v) and v > 0 for v in pair):
+            problems.append(f"{where} = {pair}: alpha and beta must be > 0, accepted range "
+                            "(0, inf)")
+            continue
+        parsed[n] = (float(pair[0]), float(pair[1]))
+    return MappingProxyType(parsed) if len(parsed) == 7 else None
+
+
+def material_search_path():
+    """The folders a material name is looked for in, in order: those listed in
+    $YADEBREAK_MATERIALS (separated by os.pathsep), the working folder's materials/, and the
+    materials shipped with the package."""
+    listed = [Path(p) for p in os.environ.get("YADEBREAK_MATERIALS", "").split(os.pathsep) if p]
+    return [*listed, Path.cwd() / "materials", MATERIALS_DIR]
+
+
+def available_materials(directory=None):
+    """Names of the material files in `directory`, or in every folder of the search path."""
+    folders = [Path(directory)] if directory is not None else material_search_path()
+    return sorted({p.stem for folder in folders for p in folder.glob("*.toml")})
+
+
+def _find(name):
+    """The file of material `name` along the search path, or None."""
+    for folder in material_search_path():
+        path = folder / f"{name}.toml"
+        if path.is_file():
+            return path
+    return None
 
 
 def load_material(name_or_path):
-    """Load and validate a material: a name from materials/ ('copper_ore') or a path to a .toml file.
+    """Load and validate a material: a name ('copper_ore', looked for along
+    material_search_path()) or a path to a .toml file.
 
     Every problem is reported at once in a MaterialError naming the file, the field and the
     accepted range. Unknown names list the available materials.
@@ -393,11 +435,11 @@ def load_material(name_or_path):
     text = str(name_or_path)
     path = Path(text)
     if not (text.endswith(".toml") or path.exists()):
-        path = MATERIALS_DIR / f"{text}.toml"
-        if not path.exists():
+        path = _find(text)
+        if path is None:
             raise MaterialError(text, [f"unknown material '{text}': available are "
                                        f"{', '.join(available_materials())} (or give a path to a "
-                                       ".toml file)"])
+                                       ".toml file, or list folders in $YADEBREAK_MATERIALS)"])
     if not path.is_file():
         raise MaterialError(path, ["file not found"])
     raw = path.read_bytes()

@@ -1,6 +1,6 @@
 """The Tavares UFRJ breakage model as plain, vectorised functions.
 
-Equation numbers are those of ../shared/MODEL.md (and of Tavares et al., the EDEM
+Equation numbers are those of docs/model.md (and of Tavares et al., the EDEM
 sphere-replacement paper). SI units throughout: sizes in metres, stiffnesses and moduli in
 pascals, specific energies in J/kg, masses in kg. t10 and the t_n markers are percentages, as the
 paper prints them.
@@ -38,7 +38,7 @@ X_MIN = 2.0 ** (-9.0 / 4.0)
 
 # --------------------------------------------------------------------------- stiffness, Eq. 4
 def hertz_stiffness(young, poisson):
-    """Hertzian stiffness k = Y / (1 - nu^2) in Pa (MODEL.md Sections 1-2), Y in Pa."""
+    """Hertzian stiffness k = Y / (1 - nu^2) in Pa (docs/model.md Sections 1-2), Y in Pa."""
     young = np.asarray(young, dtype=float)
     poisson = np.asarray(poisson, dtype=float)
     return young / (1.0 - poisson ** 2)
@@ -383,7 +383,7 @@ def repeated_impact_broken_fraction(absorbed_energy, e50, sigma, emax_ratio, gam
 
 
 # --------------------------------------------------------------------------- Section 9: Ab-T10
-# The Rocky manual's cumulative-energy criterion (MODEL.md Section 9, seeds 002 and 003). Sizes L
+# The Rocky manual's cumulative-energy criterion (docs/model.md Section 9, the Rocky manual and white paper). Sizes L
 # in metres, specific energies in J/kg, the selection function coefficient S in kg/J, t10 in %.
 
 def ab_t10_min_energy(size, e_min_ref, size_ref):
@@ -397,7 +397,7 @@ def ab_t10_update(e_t, e_prev, e_cum, e_max, e_min):
     e_t: specific energy (J/kg) of the particle's present loading, e_prev: its value at the previous
     step. e_cum grows while e_t > e_min and e_t > e_max, and e_max follows e_t; e_max resets to 0
     when the particle unloads below e_min, so a new loading counts again.
-    The increment is e_t - max(e_prev, e_max, e_min): MODEL.md's e_t - e_prev on every step of a
+    The increment is e_t - max(e_prev, e_max, e_min): docs/model.md's e_t - e_prev on every step of a
     loading, except two where that form depends on the step size. On the step that crosses e_min
     it would also count the rise from e_prev up to e_min, energy below the threshold (up to one
     step's rise: 3-7 % of e_cum in single impacts at dt = 5 % of the Rayleigh time); on the first

@@ -1,4 +1,4 @@
-"""Where fragments go inside their parent and how they move (MODEL.md Section 8). Never imports yade.
+"""Where fragments go inside their parent and how they move (docs/model.md Section 8). Never imports yade.
 
 Coarse fragments are laid side by side across the direction of the stress that broke the parent
 (the normal of its most energetic contact); finer ones fill the remaining room, nearer the loaded

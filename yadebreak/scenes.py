@@ -139,11 +139,13 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
                                                     material="steel"))
     O.engines = hertz_engines(ip2, gravity=(0.0, 0.0, -9.81), facets=bool(holder))
     if layers > 1 and settle_steps:           # settle the stack before anything is tracked
+        scene_dt = O.dt                       # the settling's own step; attach() sets the run's
         O.dt = 0.2 * utils.PWaveTimeStep()
         newton = O.engines[-1]
         newton.damping = 0.4
         O.run(settle_steps, True)
         newton.damping = 0.0
+        O.dt = scene_dt
         for i in particles:
             O.bodies[i].state.vel = (0, 0, 0)
             O.bodies[i].state.angVel = (0, 0, 0)

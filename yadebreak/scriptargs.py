@@ -35,6 +35,33 @@ def script_params(defaults, description=None, argv=None):
     return parser.parse_args(args)
 
 
+class ScriptError(ValueError):
+    """A user's mistake that a script reports in one line (exit code 2), e.g. a resume with other
+    arguments."""
+
+
+class StopRequested(Exception):
+    """--stop-after: the script ends here, as if killed (tests of --resume)."""
+
+
+def run_script(main, *args):
+    """Run a script's main(*args): a user's mistake (a bad material file, option or resume)
+    becomes one line on stderr and exit code 2, as argparse does; --stop-after ends with 0.
+    The one place where scripts turn exceptions into exit codes."""
+    from .coupling.config import AttachError
+    from .materials import MaterialError
+    try:
+        return main(*args)
+    except StopRequested:
+        raise SystemExit(0) from None
+    except MaterialError as exc:
+        message = f"{exc.source}: " + "; ".join(exc.problems)
+    except (ScriptError, AttachError, FileNotFoundError) as exc:
+        message = str(exc)
+    print(f"[yadebreak] error: {message}", file=sys.stderr, flush=True)
+    raise SystemExit(2)
+
+
 def progress(message):
     """One line of progress, flushed at once (long runs print these)."""
     print(f"[yadebreak] {message}", flush=True)
@@ -53,14 +80,14 @@ def check_resume_arguments(saved, args, path):
     now = resume_arguments(args)
     if saved != now:
         changed = sorted(k for k in set(saved) | set(now) if saved.get(k) != now.get(k))
-        raise SystemExit(f"--resume: {path} was written with other values of {changed}; run "
-                         "again without --resume or with the same values")
+        raise ScriptError(f"--resume: {path} was written with other values of {changed}; run "
+                          "again without --resume or with the same values")
 
 
 def stop_if_asked(args, units_done):
     """--stop-after N: end the script here, as if killed, once N units are done (tests)."""
     if getattr(args, "stop_after", 0) and units_done >= args.stop_after:
-        sys.exit(0)
+        raise StopRequested()
 
 
 class PartialResults:

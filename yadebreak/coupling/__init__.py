@@ -5,16 +5,25 @@
     yadebreak.save("scene.yade.gz")                                   # O.save with the state
 
 One step's data, in the order the engine (controller.py) moves it: contacts.py reads YADE's
-interactions into per-body loading; criteria.py judges it; state.py keeps bodies, events and
-the fines ledger; replacement.py and zeroing.py put the progeny in; stepping.py sets the time
-step and the next read. config.py holds the options.
+interactions into per-body loading; judging.py and criteria.py decide; state.py keeps bodies,
+events and the fines ledger; replacement.py and zeroing.py put the progeny in; stepping.py sets
+the time step and the next read; engine.py attaches it all and saves it with the scene;
+config.py holds the options. config, state, contacts, criteria and judging never import yade
+(they are tested without it); the names below that need YADE import it on first use.
 """
-from .config import AttachError, Config, options_markdown
-from .controller import Controller
-from .engine import (attach, controller, detach, forget, load_checkpoint, run_steps, save,
-                     save_checkpoint)
-from .scene_materials import add_materials
+from importlib import import_module
 
-__all__ = ["AttachError", "Config", "Controller", "add_materials", "attach", "controller",
-           "detach", "forget", "load_checkpoint", "options_markdown", "run_steps", "save",
-           "save_checkpoint"]
+from .config import AttachError, Config, options_markdown
+
+_NEED_YADE = {"attach": "engine", "controller_of": "engine", "detach": "engine", "forget": "engine",
+              "load_checkpoint": "engine", "run_steps": "engine", "save": "engine",
+              "save_checkpoint": "engine", "Controller": "controller",
+              "add_materials": "scene_materials"}
+
+__all__ = ["AttachError", "Config", "options_markdown", *_NEED_YADE]
+
+
+def __getattr__(name):
+    if name in _NEED_YADE:
+        return getattr(import_module(f".{_NEED_YADE[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -146,13 +146,9 @@ class ContactReader:
             key = (a, b)
             c = contacts.get(key)
             if c is None:
-                g = i.geom
-                if g is None:
+                c = self._new_record(i, bodies, now)
+                if c is None:
                     continue
-                ka = self.stiffness[bodies[a].material.id]
-                kb = self.stiffness[bodies[b].material.id]
-                c = ContactRecord(float(model.energy_partition(ka, kb)),
-                                  float(model.energy_partition(kb, ka)), now, g, i.phys)
                 contacts[key] = c
             elif c.geom is None:                  # restored from a save: YADE's objects again
                 c.geom, c.phys = i.geom, i.phys
@@ -207,6 +203,16 @@ class ContactReader:
                         strongest[b] = (share, g.normal, -1.0)
         self.contacts = seen
         return out
+
+    def _new_record(self, inter, bodies, now):
+        """A record for a contact seen for the first time, with Eq. 4's shares (None while YADE
+        has no geometry for it)."""
+        if inter.geom is None:
+            return None
+        ka = self.stiffness[bodies[inter.id1].material.id]
+        kb = self.stiffness[bodies[inter.id2].material.id]
+        return ContactRecord(float(model.energy_partition(ka, kb)),
+                             float(model.energy_partition(kb, ka)), now, inter.geom, inter.phys)
 
     def stored_share(self, touching):
         """Elastic energy (J) a body holds now in its counted contacts: its share of the Hertz

@@ -14,10 +14,10 @@ import warnings
 import numpy as np
 
 from .. import families, reports
-from ._yade import O, wrapper
-from .config import AttachError
+from ._yade import O
 from .contacts import ContactReader
 from .criteria import criterion_for
+from .judging import Judge
 from .replacement import Replacer
 from .state import BREAKABLE, BROKEN, UNBREAKABLE, BodyRow, EngineState
 from .stepping import FragmentDamping, ReadSchedule, SmallestBreakable, TimeStep
@@ -55,6 +55,10 @@ class Controller:
         self.replacer = Replacer(config.replacement, self.state.table, self.state.rng,
                                  self.criteria, tables, self.zeroing, self.state.ledger,
                                  self.pause_steps, config.time_step.global_damping > 0.0)
+        self.judge = Judge(self.state, self._criterion_of, self.reader,
+                           config.criteria.fragments_energy_factor,
+                           any(self.pause_steps.values()), config.reading.fast_tolerance,
+                           self._record, self._warn_jump)
         self.last_iter = -1
         self.wall_time = {"read": 0.0, "replace": 0.0}
 
@@ -104,38 +108,21 @@ class Controller:
                                                  self.material, sizes, fines, fines_model)
 
     # -- set-up --------------------------------------------------------------------------------
-    def register_bodies(self):
-        """Give every breakable sphere of the scene its state and fracture energy (attach)."""
-        found, problems = [], []
-        for b in O.bodies:
-            if b is None or b.id in self.state.table:
-                continue
-            label = self.label_by_id.get(b.material.id if b.material is not None else None)
-            if label is None:
-                continue
-            if not isinstance(b.shape, wrapper.Sphere):
-                problems.append(f"body {b.id} ({type(b.shape).__name__}) has the breakable material "
-                                f"'{label}' but only spheres can break: give it another material")
-            elif b.isClumpMember or b.isClump:
-                problems.append(f"body {b.id} is part of a clump and has the breakable material "
-                                f"'{label}': clumps cannot break; use loose spheres")
-            else:
-                found.append((b.id, label, b.state.mass, b.shape.radius))
-        if problems:
-            raise AttachError("; ".join(problems))
-        if not found:
+    def register(self, spheres):
+        """Give the breakable spheres found at attach, [(id, label, mass (kg), radius (m))] in id
+        order, their state and fracture energy, drawn per material in id order."""
+        if not spheres:
             return
-        ids = np.array([f[0] for f in found])
-        labels = [f[1] for f in found]
-        sizes = np.array([2.0 * f[3] for f in found])
+        ids = np.array([f[0] for f in spheres])
+        labels = [f[1] for f in spheres]
+        sizes = np.array([2.0 * f[3] for f in spheres])
         table = self.state.table
-        for label in dict.fromkeys(labels):         # draws per material, in id order: reproducible
+        for label in dict.fromkeys(labels):
             idx = np.array([k for k, lab in enumerate(labels) if lab == label])
             energies, extra = self.criteria[label].sample(self.state.rng, sizes[idx])
-            table.add(ids[idx], BREAKABLE, label, [found[k][2] for k in idx], sizes[idx] / 2.0,
+            table.add(ids[idx], BREAKABLE, label, [spheres[k][2] for k in idx], sizes[idx] / 2.0,
                       fracture_energy=energies, fracture_energy_initial=energies, **extra)
-        # rows were added per material: restore the scene's order (sums follow it)
-        table.known = dict.fromkeys(ids.tolist())
+        table.known = dict.fromkeys(ids.tolist())     # the scene's order (sums follow it)
         self._adopt(ids.tolist())
         self.state.top_size = max(self.state.top_size, float(sizes.max()))
 
@@ -176,111 +163,18 @@ class Controller:
         loading = self.reader.read(O.interactions, O.bodies, state.tracked, self.zeroing.pairs,
                                    O.time, interval)
         self.wall_time["read"] += time.perf_counter() - t0
-        broken, limits = self._judge(loading, interval)
+        broken, limits = self.judge.judge(loading, interval, O.iter, self.schedule.mode == "fast")
         if broken:
             self._break_all(broken)
         self.damping.release()
         self.last_iter = O.iter
         self.schedule.after_read(limits)
 
-    def _judge(self, loading, interval):
-        """Each body read now (or with an open event): paused, broken, loading, or unloaded (its
-        event closes with damage). Returns [(id, Ek', strongest contact)] of the broken bodies
-        and the steps the loaded ones allow before the next read."""
-        state = self.state
-        c = state.table.columns
-        energy = loading.energy
-        candidates = list(state.open_events.union(energy))
-        if not candidates:
-            return [], None
-        ids = np.fromiter(candidates, np.int64, len(candidates))
-        known = np.fromiter((i in state.tracked for i in candidates), bool, len(candidates))
-        paused = known & (c["pause_until"][ids] > O.iter)
-        active = known & ~paused
-        ek = np.fromiter((energy.get(i, 0.0) for i in candidates), float, len(candidates))
-        factor = self.config.criteria.fragments_energy_factor
-        if factor != 1.0:
-            ek = np.where(c["generation"][ids] > 0, ek * factor, ek)
-        specific = ek / c["mass"][ids]
-        verdict = self._verdicts(ids, active, ek, specific, interval)
-        breaks, jump, threshold, order, limits = verdict
-        c["specific_energy"][ids[active]] = specific[active]
-        grows = active & ~breaks & (ek > c["event_max"][ids])
-        was_open = c["event_max"][ids] > 0.0
-        c["event_max"][ids[grows]] = ek[grows]
-        c["event_max"][ids[paused]] = 0.0
-        c["specific_energy"][ids[paused]] = 0.0
-        return self._settle(candidates, known, paused, breaks, grows, was_open, jump, threshold,
-                            order, ek, loading), limits
-
-    def _verdicts(self, ids, active, ek, specific, interval):
-        """Each material's criterion on its active bodies (vectorised); the settling order
-        (criterion.order); the read schedule's limits."""
-        n = len(ids)
-        breaks = np.zeros(n, bool)
-        jump = np.zeros(n)
-        threshold = np.ones(n)
-        order = np.zeros(n, np.int8)
-        limits = []
-        materials = self.state.table.columns["material"][ids]
-        fast = self.schedule.mode == "fast"
-        for m in np.unique(materials[active]).tolist():
-            rows = np.nonzero(active & (materials == m))[0]
-            crit = self._criterion_of[m]
-            j = crit.judge(self.state.table, ids[rows], ek[rows], specific[rows])
-            breaks[rows], jump[rows], threshold[rows] = j.breaks, j.jump, j.threshold
-            order[rows] = crit.order
-            if fast and j.rising.any():
-                r = j.rising
-                limits.append(self.schedule.steps_allowed(j.threshold[r], j.level[r], j.rise[r],
-                                                          interval))
-        return breaks, jump, threshold, order, (np.concatenate(limits) if limits else None)
-
-    def _settle(self, candidates, known, paused, breaks, grows, was_open, jump, threshold, order,
-                ek, loading):
-        """Events open, close or break, body by body in the criteria's order (Tavares bodies,
-        then Ab-T10's: the order of the event log and of the random draws)."""
-        state = self.state
-        open_events = state.open_events
-        broken = []
-        for k in np.argsort(order, kind="stable").tolist():
-            i = candidates[k]
-            if not known[k]:
-                open_events.discard(i)
-            elif paused[k]:
-                # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
-                # did meanwhile is never counted later
-                self.reader.restart(loading.touching.get(i, ()))
-                open_events.discard(i)
-            elif breaks[k]:
-                if jump[k] > 0.8 * threshold[k]:
-                    self._warn_jump(i, jump[k], threshold[k])
-                broken.append((i, float(ek[k]), loading.strongest.get(i)))
-            elif grows[k]:
-                open_events.add(i)
-            elif (was_open[k] and i not in loading.grew
-                  and self.reader.stored_share(loading.touching.get(i, ())) <= self.reader.emin):
-                self._close_event(i, loading.touching.get(i, ()))
-        return broken
-
     def _warn_jump(self, bid, rise, scale):
         self._warn_once("jump", (
             f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
             f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s):"
             f" reduce {self.schedule.remedy()} for an accurate t10'"))
-
-    def _close_event(self, bid, touching):
-        """End of a stressing event without breakage: the criterion's damage rule (Eqs. 5-6 or
-        9.2) with the event's largest Ek'; the next event starts from the present state."""
-        table = self.state.table
-        c = table.columns
-        event_max, mass = float(c["event_max"][bid]), float(c["mass"][bid])
-        fields = self._criterion_of[c["material"][bid]].unload(table, bid)
-        if fields is not None:
-            self._record("damage", bid, specific_energy=event_max / mass, **fields)
-        c["event_max"][bid] = c["specific_energy"][bid] = 0.0
-        self.state.open_events.discard(bid)
-        self.reader.restart(touching)
 
     def _record(self, kind, bid, **fields):
         c = self.state.table.columns
@@ -349,7 +243,7 @@ class Controller:
         closed = 0
         for bid in list(state.open_events):
             if bid in state.tracked and event_max[bid] > 0.0:
-                self._close_event(bid, touching.get(bid, ()))
+                self.judge.close_event(bid, touching.get(bid, ()))
                 closed += 1
         state.open_events.clear()
         return closed
@@ -357,34 +251,6 @@ class Controller:
     def zero_overlaps(self):
         """Before the InteractionLoop (see zeroing.py)."""
         self.zeroing.apply()
-
-    # -- saving ------------------------------------------------------------------------------------
-    def to_dict(self):
-        """Everything needed to go on after O.load, JSON-able."""
-        return {"label": self.label, "options": self.config.as_options(),
-                "materials": {k: (v.source if hasattr(v, "source") else v)
-                              for k, v in self.material_names.items()},
-                "iter": O.iter, "state": self.state.to_dict(),
-                "contacts": self.reader.to_dict(), "zeroed": self.zeroing.to_list(),
-                "damped_until": self.damping.until, "fast": self.schedule.to_list()}
-
-    def restore(self, data, period):
-        """Continue from to_dict() (the state object was restored already); `period` is the
-        engine's iterPeriod as saved."""
-        table = self.state.table
-        self.smallest.rebuild((float(table.columns["radius"][i]), i) for i in self.state.tracked
-                              if table.columns["kind"][i] == BREAKABLE)
-        self.schedule.period = period
-        self.reader.restore(data["contacts"])
-        self.zeroing.restore(data["zeroed"])
-        self.damping.until = [tuple(x) for x in data["damped_until"]]
-        self.schedule.restore(data["fast"])
-        self.last_iter = data["iter"] - 1
-        for bid in table:
-            b = O.bodies[bid] if bid < len(O.bodies) else None
-            if b is not None:
-                b.breakage = BodyRow(table, bid)
-        self.state.log.rewrite()               # the log holds exactly the events of this state
 
     def close(self):
         self.state.log.close()

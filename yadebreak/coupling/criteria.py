@@ -32,6 +32,7 @@ class Judgement:
     rising: np.ndarray
     rise: np.ndarray
     jump: np.ndarray
+    order: np.ndarray | None = None       # judge_all: each body's criterion.order
 
 
 class Tavares:
@@ -60,6 +61,14 @@ class Tavares:
         rise = specific - before
         return Judgement(breaks=specific > threshold, level=specific, threshold=threshold,
                          rising=specific > before, rise=rise, jump=rise)
+
+    def judge_one(self, c, i, ek, specific):
+        """judge() for one body on Python scalars, from the columns `c`: (breaks, level,
+        threshold, rising, rise, jump)."""
+        before = c["specific_energy"][i]
+        threshold = c["fracture_energy"][i]
+        rise = specific - before
+        return specific > threshold, specific, threshold, specific > before, rise, rise
 
     def unload(self, table, i):
         """Eqs. 5-6 with the event's largest Ek' (breakable bodies only)."""
@@ -113,6 +122,16 @@ class AbT10:
         return Judgement(breaks=cum > threshold, level=cum, threshold=threshold,
                          rising=specific > before, rise=specific - before, jump=cum - cum_before)
 
+    def judge_one(self, c, i, ek, specific):
+        """judge() for one body (see Tavares.judge_one)."""
+        before = c["e_prev"][i]
+        cum_before = c["e_cum"][i]
+        cum, top = (float(v) for v in model.ab_t10_update(specific, before, cum_before,
+                                                          c["e_max"][i], c["e_min"][i]))
+        c["e_cum"][i], c["e_max"][i], c["e_prev"][i] = cum, top, specific
+        threshold = c["fracture_energy"][i]
+        return cum > threshold, cum, threshold, specific > before, specific - before, cum - cum_before
+
     def unload(self, table, i):
         """Eq. 9.2 at the unloading: e_t = 0 < e_min resets e_max; e_cum keeps the damage."""
         c = table.columns
@@ -137,6 +156,31 @@ class AbT10:
         c = table.columns
         c["e_cum"][i] = ratio * c["fracture_energy"][i]     # as if e_cum had reached it
         return ratio * float(c["mass"][i]) * float(c["fracture_energy"][i])
+
+
+def judge_all(criterion_of, table, ids, active, ek, specific, every=False):
+    """Every material's criterion on its active bodies among `ids` (vectorised per material);
+    criterion_of[m] is the criterion of material index m; `every`: all bodies are active.
+    Returns a Judgement over all `ids` (inactive rows: no breakage, not rising) with `order`,
+    the criteria's settling order."""
+    n = len(ids)
+    if every and len(criterion_of) == 1:             # one material: no grouping
+        crit = criterion_of[0]
+        j = crit.judge(table, ids, ek, specific)
+        j.order = np.full(n, crit.order, np.int8)
+        return j
+    out = Judgement(breaks=np.zeros(n, bool), level=np.zeros(n), threshold=np.ones(n),
+                    rising=np.zeros(n, bool), rise=np.zeros(n), jump=np.zeros(n),
+                    order=np.zeros(n, np.int8))
+    materials = table.columns["material"][ids]
+    for m in np.unique(materials[active]).tolist():
+        rows = np.nonzero(active & (materials == m))[0]
+        crit = criterion_of[m]
+        j = crit.judge(table, ids[rows], ek[rows], specific[rows])
+        for name in ("breaks", "level", "threshold", "rising", "rise", "jump"):
+            getattr(out, name)[rows] = getattr(j, name)
+        out.order[rows] = crit.order
+    return out
 
 
 _CRITERIA = {"tavares": Tavares, "ab_t10": AbT10}

@@ -8,8 +8,8 @@ from pathlib import Path
 from ._yade import O, wrapper
 from .config import AttachError, Config
 from .controller import Controller
-from .scene_materials import resolve
-from .state import EngineState
+from .scene_materials import breakable_spheres, resolve
+from .state import BREAKABLE, BodyRow, EngineState
 from .stepping import smallest_rayleigh_time
 
 _ENGINES: dict[str, Controller] = {}
@@ -57,7 +57,7 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
                           "reads YADE's Hertz-Mindlin forces (use add_materials() for the Ip2)")
     scene_materials = resolve(materials, config.criteria.kappa, config.criteria.emax_ratio)
     ctl = Controller(label, config, scene_materials, materials)
-    ctl.register_bodies()
+    ctl.register(breakable_spheres(scene_materials.label_by_id))
     if not len(ctl.bodies):
         ctl._warn_once("empty", "the scene has no breakable body: nothing will break (materials "
                        f"mapped: {sorted(materials)})")
@@ -80,7 +80,7 @@ def detach(label="yadebreak"):
     ctl = _ENGINES.pop(label, None)
     O.engines = [e for e in O.engines if getattr(e, "label", "") not in (label, label + "_zero")]
     if _TAG + label in O.tags.keys():
-        del O.tags[_TAG + label]
+        O.tags[_TAG + label] = ""              # O.tags cannot delete a key
     if ctl is not None:
         ctl.close()
     return ctl
@@ -94,7 +94,7 @@ def forget():
     _ENGINES.clear()
 
 
-def controller(label="yadebreak"):
+def controller_of(label="yadebreak"):
     """The controller of engine `label`, restored from the scene when it was loaded (O.load
     after yadebreak.save) or went back in time."""
     ctl = _ENGINES.get(label)
@@ -114,13 +114,17 @@ def _runs(label):
 
 
 def _store(ctl):
-    data = ctl.to_dict()
-    data["runs"] = _runs(ctl.label)
-    O.tags[_TAG + ctl.label] = json.dumps(data)
+    """Everything needed to go on after O.load, as JSON in O.tags."""
+    O.tags[_TAG + ctl.label] = json.dumps({
+        "label": ctl.label, "options": ctl.config.as_options(),
+        "materials": {k: getattr(v, "source", v) for k, v in ctl.material_names.items()},
+        "iter": O.iter, "runs": _runs(ctl.label), "state": ctl.state.to_dict(),
+        "contacts": ctl.reader.to_dict(), "zeroed": ctl.zeroing.to_list(),
+        "damped_until": ctl.damping.until, "fast": ctl.schedule.to_list()})
 
 
 def _restore(label):
-    if _TAG + label not in O.tags.keys():
+    if _TAG + label not in O.tags.keys() or not O.tags[_TAG + label]:
         raise AttachError(f"yadebreak engine '{label}' has no state in this scene")
     data = json.loads(O.tags[_TAG + label])
     if any(now > then + 1 for now, then in zip(_runs(label), data["runs"])):
@@ -132,8 +136,21 @@ def _restore(label):
     scene_materials = resolve(data["materials"], config.criteria.kappa, config.criteria.emax_ratio)
     state = EngineState.from_dict(data["state"], config.output.event_log)
     ctl = Controller(label, config, scene_materials, data["materials"], state)
+    table = state.table
+    ctl.smallest.rebuild((float(table.columns["radius"][i]), i) for i in state.tracked
+                         if table.columns["kind"][i] == BREAKABLE)
     engine = _find_engine(label)
-    ctl.restore(data, engine.iterPeriod if engine is not None else 1)
+    ctl.schedule.period = engine.iterPeriod if engine is not None else 1
+    ctl.schedule.restore(data["fast"])
+    ctl.reader.restore(data["contacts"])
+    ctl.zeroing.restore(data["zeroed"])
+    ctl.damping.until = [tuple(x) for x in data["damped_until"]]
+    ctl.last_iter = data["iter"] - 1
+    for bid in table:
+        b = O.bodies[bid] if bid < len(O.bodies) else None
+        if b is not None:
+            b.breakage = BodyRow(table, bid)
+    state.log.rewrite()                    # the log holds exactly the events of this state
     return ctl
 
 
@@ -161,7 +178,7 @@ def load_checkpoint(path, label="yadebreak"):
     if not path.exists():
         raise FileNotFoundError(f"--resume: no checkpoint at {path}; run without --resume first")
     O.load(str(path))
-    return controller(label), json.loads(O.tags[_SCRIPT_TAG])
+    return controller_of(label), json.loads(O.tags[_SCRIPT_TAG])
 
 
 def run_steps(steps):
@@ -175,9 +192,9 @@ def run_steps(steps):
 
 def on_read(label):
     """Called by the PyRunner after the InteractionLoop."""
-    controller(label).step()
+    controller_of(label).step()
 
 
 def on_zero(label):
     """Called by the PyRunner before the InteractionLoop."""
-    controller(label).zero_overlaps()
+    controller_of(label).zero_overlaps()

@@ -89,3 +89,25 @@ def resolve(materials, kappa=None, emax_ratio=None):
         if m.label in by_label:
             label_by_id[m.id] = m.label
     return SceneMaterials(by_label, label_by_id, stiffness)
+
+
+def breakable_spheres(label_by_id):
+    """[(id, label, mass, radius)] of the scene's bodies with a breakable material (attach only:
+    a pass over every body); anything but a loose sphere with such a material is an error."""
+    found, problems = [], []
+    for b in O.bodies:
+        label = label_by_id.get(b.material.id if b is not None and b.material is not None
+                                else None)
+        if label is None:
+            continue
+        if not isinstance(b.shape, wrapper.Sphere):
+            problems.append(f"body {b.id} ({type(b.shape).__name__}) has the breakable material "
+                            f"'{label}' but only spheres can break: give it another material")
+        elif b.isClumpMember or b.isClump:
+            problems.append(f"body {b.id} is part of a clump and has the breakable material "
+                            f"'{label}': clumps cannot break; use loose spheres")
+        else:
+            found.append((b.id, label, b.state.mass, b.shape.radius))
+    if problems:
+        raise AttachError("; ".join(problems))
+    return found

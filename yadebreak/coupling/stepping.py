@@ -5,8 +5,6 @@ from __future__ import annotations
 import heapq
 import math
 
-import numpy as np
-
 from .. import placement
 from ._yade import O, wrapper
 
@@ -51,15 +49,8 @@ class ReadSchedule:
         self._load_key = None
         self._load_time_1 = 0.0
 
-    def steps_allowed(self, threshold, level, rise, interval):
-        """"fast": steps until the next read for bodies whose criterion variable is `level`
-        below `threshold` (J/kg) and rose by `rise` over the last `interval` steps: half the way
-        to the threshold, or fast_tolerance of it, at the present rate (arrays)."""
-        return (np.maximum(self.options.fast_tolerance * threshold, 0.5 * (threshold - level))
-                * interval / rise)
-
     def after_read(self, limits):
-        """Set the period after a read; `limits` (an array or None) are the steps the loaded
+        """Set the period after a read; `limits` (a list or None) are the steps the loaded
         bodies allow ("fast")."""
         if self.mode == "auto":
             self._auto()
@@ -109,8 +100,8 @@ class ReadSchedule:
                     radius, mat.density, mat.young, mat.poisson, 1.0))   # at 1 m/s; ~ v^-1/5
             load_time = self._load_time_1 * max(2.0 * self.speed_max, 1e-6) ** -0.2
             k = min(FAST_MAX_PERIOD, int(self.options.fast_fraction * load_time / O.dt))
-        if limits is not None and len(limits):
-            k = min(k, int(limits.min()))
+        if limits:
+            k = min(k, int(min(limits)))
         self.set_period(max(1, k))
 
     def set_period(self, k):

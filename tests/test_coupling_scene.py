@@ -1,0 +1,111 @@
+"""How the engine sits in a user's scene (issue 14): it leaves the user's globals and smaller
+O.dt alone, is saved with yadebreak.save (a scene saved with O.save alone refuses to go on),
+detaches cleanly, and finds material files outside the repository (YADE)."""
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.yade
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _scene(**options):
+    from yade import O, utils
+    from yadebreak import coupling, scenes
+    ip2, _ = coupling.add_materials({"ore": "copper_ore", "steel": "steel"})
+    O.bodies.append(utils.wall(0, axis=2, material="steel"))
+    b = utils.sphere((0, 0, 0.0029), 0.00275, material="ore")
+    b.state.vel = (0, 0, -5.0)
+    O.bodies.append(b)
+    O.engines = scenes.hertz_engines(ip2)
+    return coupling
+
+
+def test_stepping_from_a_function_leaves_the_users_globals_alone(tmp_path):
+    """PyRunners with YADE's default updateGlobals=True copy the caller's locals into __main__."""
+    script = tmp_path / "user.py"
+    script.write_text(textwrap.dedent(f"""
+        import sys
+        sys.path.insert(0, {str(ROOT)!r})
+        from yade import O, utils
+        from yadebreak import coupling, scenes
+        ip2, _ = coupling.add_materials({{"ore": "copper_ore", "steel": "steel"}})
+        O.bodies.append(utils.wall(0, axis=2, material="steel"))
+        O.bodies.append(utils.sphere((0, 0, 0.003), 0.00275, material="ore"))
+        O.engines = scenes.hertz_engines(ip2)
+        coupling.attach({{"ore": "copper_ore"}})
+        steps = 7
+        step = "mine"
+        def advance(n):
+            steps = n
+            for _ in range(n):
+                O.step()
+        advance(20)
+        coupling.run_steps(50)
+        print("GLOBALS", steps, step)
+        """))
+    proc = subprocess.run(["yade", "-n", "-x", str(script)], capture_output=True, text=True,
+                          timeout=300)
+    assert "GLOBALS 7 mine" in proc.stdout, proc.stdout[-1500:] + proc.stderr[-1500:]
+
+
+def test_a_smaller_time_step_set_before_attach_is_kept_a_larger_one_lowered(scene):
+    from yade import O
+    from yadebreak import placement, load_material
+    cu = load_material("copper_ore")
+    tr = float(placement.rayleigh_time(0.00275, cu.density, cu.young_modulus, cu.poisson_ratio))
+    coupling = _scene()
+    O.dt = 0.02 * tr
+    coupling.attach({"ore": "copper_ore"})
+    assert O.dt == pytest.approx(0.02 * tr, rel=1e-12)
+    coupling.forget()
+    O.reset()
+    coupling = _scene()
+    O.dt = 0.5 * tr
+    coupling.attach({"ore": "copper_ore"})
+    assert O.dt == pytest.approx(0.05 * tr, rel=1e-12)
+
+
+def test_a_scene_saved_with_o_save_alone_refuses_to_go_on(scene, tmp_path):
+    from yade import O
+    from yadebreak.coupling import AttachError
+    coupling = _scene()
+    coupling.attach({"ore": "copper_ore"})
+    coupling.run_steps(30)
+    O.save(str(tmp_path / "plain.yade.gz"))          # yadebreak's state stays the attach's
+    coupling.forget()
+    O.load(str(tmp_path / "plain.yade.gz"))
+    with pytest.raises(AttachError, match=r"save scenes with yadebreak.save\(path\)"):
+        coupling.controller_of()
+
+
+def test_detach_removes_the_engine_and_keeps_the_results(scene):
+    from yade import O
+    coupling = _scene()
+    brk = coupling.attach({"ore": "copper_ore"}, seed=2)
+    coupling.run_steps(400)
+    events = list(brk.events)
+    assert events                                     # the impact was recorded
+    assert coupling.detach() is brk
+    assert not [e for e in O.engines if "yadebreak" in getattr(e, "label", "")]
+    coupling.run_steps(50)
+    assert brk.events == events and coupling.attach({"ore": "copper_ore"}) is not brk
+
+
+def test_materials_are_found_from_any_folder_and_a_working_folder_overrides(tmp_path):
+    """Outside the repository the shipped files are found; a folder's materials/ comes first."""
+    (tmp_path / "materials").mkdir()
+    text = (ROOT / "materials" / "copper_ore.toml").read_text()
+    (tmp_path / "materials" / "my_ore.toml").write_text(text.replace('name = "copper_ore"',
+                                                                     'name = "my_ore"'))
+    code = ("import yadebreak; print(yadebreak.load_material('granulite').name, "
+            "yadebreak.load_material('my_ore').name)")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=60)
+    assert proc.stdout.split() == ["granulite", "my_ore"], proc.stderr

@@ -1,0 +1,205 @@
+"""The engine's parts without YADE (issue 14): options, body state, event log and ledger with their
+save/restore round trips, both criteria on scripted loading histories, and the judge's two paths
+(body by body and with numpy) giving the same decisions."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from yadebreak import load_material, model
+from yadebreak.coupling import config, criteria, judging
+from yadebreak.coupling.contacts import ContactReader, Loading
+from yadebreak.coupling.state import (BREAKABLE, DUMMY, FORMAT_VERSION, UNBREAKABLE, BodyTable,
+                                      EngineState, FinesLedger, check_format)
+
+
+# -- options ----------------------------------------------------------------------------------
+def test_options_are_grouped_with_their_defaults():
+    cfg = config.Config.from_options(seed=3, read_period="fast", dummies="ledger")
+    assert cfg.reading.read_period == "fast" and cfg.replacement.dummies == "ledger"
+    assert cfg.reading.emin == 1e-4 and cfg.time_step.time_step_fraction == 0.05
+    assert config.Config.from_options(**cfg.as_options()) == cfg
+
+
+@pytest.mark.parametrize("option, text", [
+    (dict(emin=-1.0), "emin = -1.0 J: accepted >= 0"),
+    (dict(cs=2), "cs = 2: accepted [0, 1]"),
+    (dict(read_period=0), "read_period = 0 steps: accepted an integer >= 1, 'auto' or 'fast'"),
+    (dict(dmin=0.0), "dmin = 0.0 m: accepted > 0 or None"),
+    (dict(global_damping_time=math.nan), "global_damping_time = nan s: accepted >= 0"),
+])
+def test_a_bad_option_names_itself_its_value_range_and_unit(option, text):
+    with pytest.raises(config.AttachError, match="bad option") as err:
+        config.Config.from_options(**option)
+    assert text in str(err.value)
+
+
+def test_every_option_is_documented_from_the_table():
+    doc = config.options_markdown()
+    assert all(f"`{o.name}`" in doc for o in config.OPTIONS)
+
+
+# -- state ------------------------------------------------------------------------------------
+def _state():
+    st = EngineState(["ore", "rock"], seed=5, event_log=None)
+    st.table.add([3, 4, 7], BREAKABLE, "ore", [1e-3, 2e-3, 3e-3], [1e-3, 2e-3, 3e-3],
+                 fracture_energy=[100.0, 200.0, 300.0], fracture_energy_initial=[100.0, 200, 300])
+    st.table.add([9], DUMMY, "rock", 1e-4, 2e-4, t10=5.0, parent_size=4e-3)
+    st.tracked.update([3, 4, 7])
+    st.open_events.add(4)
+    st.table[4].event_max = 0.05
+    st.ledger.add(2e-5, 4e-3, 6.0, "ore", (1e-5, 0.0, -2e-5))
+    st.log.record({"kind": "damage", "id": 3, "specific_energy": 12.5})
+    st.warned.add("jump")
+    return st
+
+
+def test_body_rows_read_and_write_their_columns():
+    st = _state()
+    row = st.table[7]
+    assert row.kind == "breakable" and row.material == "ore" and row.fracture_energy == 300.0
+    row.fracture_energy = 250.0
+    assert st.table.columns["fracture_energy"][7] == 250.0
+    assert st.table[9].kind == "dummy" and math.isinf(st.table[9].fracture_energy)
+    assert math.isnan(st.table[3].t10) and 5 not in st.table and len(st.table) == 4
+    with pytest.raises(KeyError):
+        st.table[5]
+
+
+def test_state_round_trip_continues_the_same_random_stream():
+    st = _state()
+    st.rng.random(3)
+    data = json.loads(json.dumps(st.to_dict()))               # as stored in O.tags
+    back = EngineState.from_dict(data)
+    assert back.to_dict() == st.to_dict()
+    assert back.rng.random(4).tolist() == st.rng.random(4).tolist()
+    assert back.open_events == {4} and back.tracked == {3, 4, 7}
+    assert back.table[9].kind == "dummy" and back.table[9].parent_size == 4e-3
+    assert back.total_mass() == st.total_mass() == pytest.approx(1e-3 + 2e-3 + 3e-3 + 1e-4 + 2e-5)
+
+
+def test_saved_state_of_another_format_is_refused_with_its_version():
+    data = _state().to_dict()
+    data["format_version"] = FORMAT_VERSION + 1
+    with pytest.raises(ValueError, match=f"format version {FORMAT_VERSION + 1}"):
+        check_format(data)
+
+
+def test_ledger_carries_mass_and_kinetic_energy():
+    ledger = FinesLedger()
+    ledger.add(2.0, 1e-3, 5.0, "ore", (2.0, 0.0, 0.0))          # 1 m/s
+    ledger.add(1.0, 1e-3, 5.0, "ore", (0.0, 3.0, 4.0))          # 5 m/s
+    assert ledger.total_mass() == 3.0
+    assert ledger.kinetic_energy() == pytest.approx(0.5 * 2 * 1 + 0.5 * 1 * 25)
+    assert FinesLedger(json.loads(json.dumps(ledger.to_list()))).to_list() == ledger.to_list()
+
+
+# -- criteria on scripted loading histories -----------------------------------------------------
+def _one_body(material_name, fracture_energy, mass=1e-4, size=5.5e-3):
+    mat = load_material(material_name)
+    crit = criteria.criterion_for(mat)
+    table = BodyTable(["ore"])
+    extra = {"e_min": float(mat.min_energy(size))} if isinstance(crit, criteria.AbT10) else {}
+    table.add([0], BREAKABLE, "ore", mass, size / 2, fracture_energy=fracture_energy,
+              fracture_energy_initial=fracture_energy, **extra)
+    return mat, crit, table
+
+
+def _load(crit, table, history, mass=1e-4):
+    """Judge body 0 along a history of specific energies (J/kg); the step it breaks, or None."""
+    c = table.columns
+    for step, specific in enumerate(history):
+        j = crit.judge(table, np.array([0]), np.array([specific * mass]), np.array([specific]))
+        c["specific_energy"][0] = specific
+        c["event_max"][0] = max(c["event_max"][0], specific * mass)
+        if j.breaks[0]:
+            return step
+    return None
+
+
+def test_tavares_breaks_at_the_first_read_above_its_fracture_energy_and_is_weakened_below():
+    mat, crit, table = _one_body("copper_ore", 200.0)
+    assert _load(crit, table, np.linspace(0, 190, 20)) is None
+    fields = crit.unload(table, 0)                       # the event ends at 190 J/kg
+    expected = float(model.weakened_fracture_energy(200.0, 190.0 / 200.0, mat.gamma))
+    assert fields["fracture_energy_after"] == pytest.approx(expected, rel=1e-12)
+    assert table[0].damage == pytest.approx(1 - expected / 200.0, rel=1e-12)
+    table[0].specific_energy = table[0].event_max = 0.0
+    history = np.linspace(0, 2 * expected, 41)
+    assert _load(crit, table, history) == int(np.argmax(history > expected))
+    ratio, t10, _ = crit.breakage(table, 0, history[-1] * 1e-4)
+    assert t10 == pytest.approx(float(model.t10(ratio, mat.A, mat.b_prime, mat.kappa)))
+
+
+def test_ab_t10_accumulates_e_minus_e_min_per_loading_and_breaks_past_its_threshold():
+    mat, crit, table = _one_body("ab_t10_ore", 1e9)
+    e_min = table[0].e_min
+    for loading in range(3):                              # three loadings to 150 J/kg
+        _load(crit, table, np.concatenate([np.linspace(0, 150, 30), np.linspace(150, 0, 10)]))
+        crit.unload(table, 0)
+        assert table[0].e_cum == pytest.approx((loading + 1) * (150 - e_min), rel=1e-12)
+    table[0].fracture_energy = threshold = table[0].e_cum + 40.0
+    history = np.linspace(0, 150, 151)
+    step = _load(crit, table, history)
+    assert history[step] - e_min > 40.0 >= history[step - 1] - e_min   # crossed at that read
+    _, t10, extra = crit.breakage(table, 0, 0.0)
+    assert extra["e_cum"] > threshold
+    assert t10 == pytest.approx(float(mat.t10_of_cumulative_energy(extra["e_cum"], 5.5e-3)))
+
+
+# -- the judge: body by body and with numpy, the same ---------------------------------------------
+def _scene(seed):
+    rng = np.random.default_rng(seed)
+    mats = [load_material("copper_ore"), load_material("ab_t10_ore")]
+    st = EngineState(["cu", "ab"], seed)
+    n = 40
+    ids = np.arange(n) * 2 + 1
+    mat_index = rng.integers(0, 2, n)
+    st.table.add(ids, np.where(rng.random(n) < 0.9, BREAKABLE, UNBREAKABLE), mat_index,
+                 rng.uniform(1e-5, 1e-4, n), 1e-3, fracture_energy=rng.uniform(20, 400, n),
+                 specific_energy=rng.uniform(0, 100, n), generation=rng.integers(0, 2, n),
+                 pause_until=rng.integers(0, 20, n), e_min=rng.uniform(0, 30, n),
+                 e_cum=rng.uniform(0, 50, n), e_prev=rng.uniform(0, 80, n))
+    loaded = rng.random(n) < 0.6
+    st.table.columns["event_max"][ids] = np.where(rng.random(n) < 0.5,
+                                                  rng.uniform(0, 2e-2, n), 0.0)
+    st.tracked.update(ids[rng.random(n) < 0.9].tolist())
+    st.open_events.update(ids[(st.table.columns["event_max"][ids] > 0)].tolist())
+    loading = Loading()
+    for i, load, m in zip(ids.tolist(), loaded, st.table.columns["mass"][ids]):
+        if load:
+            loading.energy[i] = float(m * rng.uniform(0, 500))
+    return st, [criteria.criterion_for(m) for m in mats], loading
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_both_judge_paths_make_the_same_decisions(seed):
+    results = []
+    for path in ("plan_each", "plan_all"):
+        st, crits, loading = _scene(seed)
+        records = []
+        judge = judging.Judge(st, crits, ContactReader({}, 0.0, 1e-4), 0.7 if seed % 2 else 1.0,
+                              True, 0.02, lambda kind, i, **f: records.append((kind, i, f)),
+                              lambda *a: None)
+        candidates = list(st.open_events.union(loading.energy))
+        plan = getattr(judge, path)(candidates, loading.energy, 3, 10, True)
+        broken = judge.settle(candidates, plan, loading)
+        results.append((broken, records, sorted(st.open_events), plan.need, plan.order,
+                        sorted(plan.limits),
+                        json.dumps({k: v.tolist() for k, v in st.table.columns.items()})))
+    each, every = results
+    assert each[0] and each[1]          # the scene breaks some bodies and closes some events
+    assert each == every
+
+
+def test_docs_options_is_the_table_as_rendered_now():
+    """docs/options.md is `python3 -m yadebreak options`: regenerate it when config.py changes."""
+    import contextlib
+    import io
+    from pathlib import Path
+    from yadebreak.__main__ import main
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        main(["options"])
+    assert (Path(__file__).resolve().parent.parent / "docs" / "options.md").read_text() == out.getvalue()

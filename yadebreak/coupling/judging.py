@@ -1,0 +1,181 @@
+"""The judge stage of a read: which bodies break, which stressing events open or close (with
+damage), and how long the loaded bodies allow until the next read. No yade import: the caller
+passes the step and the recorder of events.
+
+Two equal paths: a few bodies (the usual case in laboratory scenes) are judged one by one on
+Python scalars, many bodies (process scale) with numpy over all of them; both give the same
+decisions and numbers (tests/test_judging.py)."""
+from __future__ import annotations
+
+from itertools import repeat
+
+import numpy as np
+
+from .criteria import judge_all
+
+#: up to this many bodies in a read are judged one by one (numpy's fixed cost per call, about
+#: 1 us, makes the array path dearer below it)
+SMALL = 12
+
+# what a body needs after the criteria spoke
+NOTHING, FORGET, PAUSE, BREAK, OPEN, CLOSE_IF_UNLOADED = range(6)
+
+
+def steps_allowed(tolerance, threshold, level, rise, interval):
+    """"fast" reads: steps until the next read for bodies whose criterion variable is `level`
+    below `threshold` (J/kg) and rose by `rise` over the last `interval` steps: half the way to
+    the threshold, or `tolerance` of it, at the present rate (scalars or arrays)."""
+    floor, half = tolerance * threshold, 0.5 * (threshold - level)
+    larger = np.maximum(floor, half) if isinstance(floor, np.ndarray) else max(floor, half)
+    return larger * interval / rise
+
+
+class Plan:
+    """A read's decisions: for each candidate its need (codes above), criterion order, Ek' (J),
+    jump and threshold (J/kg); and the steps the loaded bodies allow (a list; fast reads)."""
+
+    __slots__ = ("need", "order", "ek", "jump", "threshold", "limits")
+
+    def __init__(self, need, order, ek, jump, threshold, limits):
+        self.need, self.order, self.ek = need, order, ek
+        self.jump, self.threshold, self.limits = jump, threshold, limits
+
+
+class Judge:
+    """Judges the bodies a read found loaded (or with an open event)."""
+
+    def __init__(self, state, criterion_of, reader, energy_factor, pausing, fast_tolerance,
+                 record, warn_jump):
+        self.state = state
+        self.criterion_of = criterion_of          # material index -> criterion
+        self.reader = reader                      # contacts.ContactReader
+        self.energy_factor = energy_factor        # fragments_energy_factor
+        self.pausing = pausing                    # some material pauses fresh fragments
+        self.fast_tolerance = fast_tolerance
+        self.record = record                      # record(kind, id, **fields)
+        self.warn_jump = warn_jump                # warn_jump(id, rise, threshold)
+
+    def judge(self, loading, interval, now_iter, fast):
+        """Returns [(id, Ek', strongest contact)] of the bodies that break now, and the steps the
+        loaded ones allow before the next read (None unless `fast`)."""
+        candidates = list(self.state.open_events.union(loading.energy))
+        if not candidates:
+            return [], None
+        plan_of = self.plan_each if len(candidates) <= SMALL else self.plan_all
+        plan = plan_of(candidates, loading.energy, interval, now_iter, fast)
+        return self.settle(candidates, plan, loading), plan.limits
+
+    def _specific(self, i, e, c):
+        if self.energy_factor != 1.0 and c["generation"][i] > 0:
+            e = e * self.energy_factor
+        return e, e / c["mass"][i]
+
+    def plan_each(self, candidates, energy, interval, now_iter, fast):
+        """The decisions body by body (Python scalars)."""
+        c = self.state.table.columns
+        tracked = self.state.tracked
+        n = len(candidates)
+        need, order = [NOTHING] * n, [0] * n
+        eks, jumps, thresholds, limits = [0.0] * n, [0.0] * n, [1.0] * n, []
+        for k, i in enumerate(candidates):
+            if i not in tracked:
+                need[k] = FORGET
+                continue
+            if self.pausing and c["pause_until"][i] > now_iter:
+                need[k] = PAUSE
+                c["event_max"][i] = c["specific_energy"][i] = 0.0
+                continue
+            e, specific = self._specific(i, energy.get(i, 0.0), c)
+            crit = self.criterion_of[c["material"][i]]
+            breaks, level, threshold, rising, rise, jump = crit.judge_one(c, i, e, specific)
+            if fast and rising:
+                limits.append(steps_allowed(self.fast_tolerance, threshold, level, rise, interval))
+            c["specific_energy"][i] = specific
+            before = c["event_max"][i]
+            if breaks:
+                need[k] = BREAK
+            elif e > before:
+                c["event_max"][i] = e
+                need[k] = OPEN
+            elif before > 0.0:
+                need[k] = CLOSE_IF_UNLOADED
+            order[k], eks[k], jumps[k], thresholds[k] = crit.order, e, jump, threshold
+        return Plan(need, order, eks, jumps, thresholds, limits)
+
+    def plan_all(self, candidates, energy, interval, now_iter, fast):
+        """The same decisions with numpy over all the candidates."""
+        c = self.state.table.columns
+        n = len(candidates)
+        ids = np.fromiter(candidates, np.int64, n)
+        known = np.fromiter(map(self.state.tracked.__contains__, candidates), bool, n)
+        paused = (known & (c["pause_until"][ids] > now_iter) if self.pausing
+                  else np.zeros(n, bool))
+        active = known & ~paused
+        ek = np.fromiter(map(energy.get, candidates, repeat(0.0, n)), float, n)
+        if self.energy_factor != 1.0:
+            ek = np.where(c["generation"][ids] > 0, ek * self.energy_factor, ek)
+        specific = ek / c["mass"][ids]
+        v = judge_all(self.criterion_of, self.state.table, ids, active, ek, specific,
+                      bool(active.all()))
+        limits = None
+        if fast and v.rising.any():
+            r = v.rising
+            limits = steps_allowed(self.fast_tolerance, v.threshold[r], v.level[r], v.rise[r],
+                                   interval).tolist()
+        event_max = c["event_max"][ids]
+        grows = active & ~v.breaks & (ek > event_max)
+        c["specific_energy"][ids[active]] = specific[active]
+        c["event_max"][ids[grows]] = ek[grows]
+        c["event_max"][ids[paused]] = 0.0
+        c["specific_energy"][ids[paused]] = 0.0
+        need = np.full(n, NOTHING, np.int8)
+        for what, mask in ((CLOSE_IF_UNLOADED, active & (event_max > 0.0)), (OPEN, grows),
+                           (BREAK, active & v.breaks), (PAUSE, paused), (FORGET, ~known)):
+            need[mask] = what
+        return Plan(need.tolist(), v.order.tolist(), ek.tolist(), v.jump.tolist(),
+                    v.threshold.tolist(), limits)
+
+    def settle(self, candidates, plan, loading):
+        """Events open, close or break, body by body in the criteria's order (Tavares bodies,
+        then Ab-T10's: the order of the event log and of the random draws)."""
+        open_events = self.state.open_events
+        broken = []
+        visit = range(len(candidates))
+        if any(plan.order):
+            visit = sorted(visit, key=plan.order.__getitem__)      # stable
+        for k in visit:
+            what = plan.need[k]
+            if what == NOTHING:
+                continue
+            i = candidates[k]
+            if what == OPEN:
+                open_events.add(i)
+            elif what == CLOSE_IF_UNLOADED:
+                touching = loading.touching.get(i, ())
+                if i not in loading.grew and self.reader.stored_share(touching) <= self.reader.emin:
+                    self.close_event(i, touching)
+            elif what == BREAK:
+                if plan.jump[k] > 0.8 * plan.threshold[k]:
+                    self.warn_jump(i, plan.jump[k], plan.threshold[k])
+                broken.append((i, float(plan.ek[k]), loading.strongest.get(i)))
+            elif what == PAUSE:
+                # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
+                # did meanwhile is never counted later
+                self.reader.restart(loading.touching.get(i, ()))
+                open_events.discard(i)
+            else:
+                open_events.discard(i)
+        return broken
+
+    def close_event(self, bid, touching):
+        """End of a stressing event without breakage: the criterion's damage rule (Eqs. 5-6 or
+        9.2) with the event's largest Ek'; the next event starts from the present state."""
+        table = self.state.table
+        c = table.columns
+        event_max, mass = float(c["event_max"][bid]), float(c["mass"][bid])
+        fields = self.criterion_of[c["material"][bid]].unload(table, bid)
+        if fields is not None:
+            self.record("damage", bid, specific_energy=event_max / mass, **fields)
+        c["event_max"][bid] = c["specific_energy"][bid] = 0.0
+        self.state.open_events.discard(bid)
+        self.reader.restart(touching)
