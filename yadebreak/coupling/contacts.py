@@ -130,8 +130,8 @@ class ContactReader:
         """One pass over the interactions; contacts that ceased drop out. `zeroed` holds the pairs
         whose kno varies; `interval` is the steps since the last read."""
         cs, emin = self.cs, self.emin
-        law = self.law
-        first_touch = law.first_touch_factor(interval)
+        work_loading, work_to_peak = self.law.loading, self.law.to_peak
+        first_touch = self.law.first_touch_factor(interval)
         contacts = self.contacts
         seen = {}
         out = Loading()
@@ -160,9 +160,9 @@ class ContactReader:
             if delta > d0 or peaked:
                 hertz = not (zeroed and ((a, b) in zeroed or (b, a) in zeroed))
                 if delta > d0:
-                    work = law.loading(c, delta, force, hertz, first_touch)
+                    work = work_loading(c, delta, force, hertz, first_touch)
                 else:
-                    work = law.to_peak(c, delta, now, hertz)
+                    work = work_to_peak(c, delta, now, hertz)
                 if work is not None:
                     c.work += work
                     if in_a:

@@ -140,8 +140,10 @@ class Controller:
             O.bodies[i].breakage = BodyRow(table, i)
 
     def _smallest_breakable(self):
-        kind = self.state.table.columns["kind"]
-        return self.smallest.get(lambda i: i in self.state.tracked and kind[i] == BREAKABLE)
+        return self.smallest.get(self._still_breakable)
+
+    def _still_breakable(self, i):
+        return i in self.state.tracked and self.state.table.columns["kind"][i] == BREAKABLE
 
     def _warn_once(self, cause, message):
         if cause not in self.state.warned:
