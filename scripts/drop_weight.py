@@ -46,8 +46,7 @@ def main(args):
         result = reports.breakage_result(brk, ids, mat, args.size, energy, steel)
         result["mass_relative_error"] = abs(brk.total_mass() - initial_mass) / initial_mass
         partial.add(energy, result)
-        progress(f"{energy:g} J/kg: {100 * result['broken_fraction']:.1f} % broken (model "
-                 f"{100 * result['model_probability']:.1f} %), {time.time() - start:.1f} s")
+        progress(f"{reports.result_line(result)}, {time.time() - start:.1f} s")
 
     results = partial.ordered(energies)
     (out / "summary.json").write_text(json.dumps({"material": mat.name, "size": args.size,

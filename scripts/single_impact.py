@@ -45,7 +45,7 @@ def main(args):
                                        time_step_fraction=args.time_step_fraction,
                                        event_log=str(out / f"events_{energy:g}.jsonl"))
         initial_mass = brk.total_mass()
-        steps = scenes.run_until_rebound(ids)
+        steps = scenes.run_until_rebound(ids, brk=brk)
         result = reports.breakage_result(brk, ids, mat, args.size, energy, target)
         intact = [e for e in reports.first_events(brk.events, ids).values() if e["kind"] == "damage"]
         result.update({
@@ -54,9 +54,7 @@ def main(args):
                                                              for e in intact])) if intact else None),
             "mass_relative_error": abs(brk.total_mass() - initial_mass) / initial_mass})
         partial.add(energy, result)
-        progress(f"{energy:g} J/kg: {100 * result['broken_fraction']:.1f} % broken (model "
-                 f"{100 * result['model_probability']:.1f} %), {steps} steps, "
-                 f"{time.time() - start:.1f} s")
+        progress(f"{reports.result_line(result)}, {steps} steps, {time.time() - start:.1f} s")
 
     results = partial.ordered(energies)
     summary = {"material": mat.name, "size": args.size, "target": args.target, "share_e": share,

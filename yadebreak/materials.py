@@ -160,6 +160,24 @@ class Material:
                              "(t10_of_cumulative_energy), not from Eq. 8")
         return model.t10(ratio, self.A, self.b_prime, self.kappa)
 
+    def t10_model(self, specific_energy, size, partner=None):
+        """The model's t10 (%) of particles of size `size` (m) each stressed once with
+        `specific_energy` = Ek/mp (J/kg) against `partner` (a Material; None: the energy given is
+        already absorbed). Tavares: Eq. 7 with the absorbed energy e Ek/mp and the median fracture
+        energy of the particles that break at it (E50b). Ab-T10: the mean of Eq. 9.4 over the
+        particles that break: each breaks when e_cum reaches its strength u (uniform), with
+        t10 = M u, so the mean is M P / 2, P = P(e_cum) of one such loading. NaN where no particle
+        breaks."""
+        share = 1.0 if partner is None else self.energy_partition(partner)
+        absorbed = share * np.asarray(specific_energy, dtype=float)
+        if self.is_ab_t10:
+            e_cum = model.ab_t10_single_impact_cum(absorbed, self.min_energy(size))
+            t10 = 0.5 * self.t10_of_cumulative_energy(e_cum, size)
+            return np.where(t10 > 0.0, t10, np.nan)
+        e50b = model.median_fracture_energy_broken(absorbed, self.median_fracture_energy(size),
+                                                   self.sigma, self.emax_ratio)
+        return model.t10_batch(absorbed, e50b, self.A, self.b_prime)
+
     def t10_of_cumulative_energy(self, e_cum, size):
         """Ab-T10, Eq. 9.4: t10 (%) of a particle of size `size` (m) broken at e_cum (J/kg)."""
         return model.ab_t10_t10(e_cum, size, self.min_energy(size), self.selection,

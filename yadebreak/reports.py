@@ -65,18 +65,26 @@ def first_events(events, ids):
     return {i: first[i] for i in ids if i in first}
 
 
+#: progeny sizes reported beside t10, as fractions 1/n of the original size (Eq. 10's t_n)
+MARKERS = (2.0, 4.0, 10.0, 25.0)
+
+
 def breakage_result(brk, ids, material, size, specific_energy, partner):
-    """Broken fraction of the particles `ids` beside the model's probability P(e Ek/mp), and,
-    when any broke, the progeny's size distribution (fines included, sieves below the feed size)
-    and t10 beside the model's (t10_model: the events' mean, Eq. 8 or, for Ab-T10, Eq. 9.4) and
-    Eq. 10."""
+    """Broken fraction of the particles `ids` beside the model's probability P(e Ek/mp), and the
+    progeny of the broken ones (fines included, every generation of fragments) beside the model
+    at that energy: t10 against Eq. 7 (material.t10_model: the absorbed energy e Ek/mp over the
+    median fracture energy of the particles that break at it; Ab-T10: Eq. 9.4), the passing at
+    1/2, 1/4 and 1/25 of the original size against Eq. 10 at that t10, and the whole curve.
+    Also the mean t10' of the primary breakage events (Eq. 8 or 9.4), for the record."""
     first = first_events(brk.events, ids)
     broken = [e for e in first.values() if e["kind"] == "breakage"]
     p_model = float(material.breakage_probability(specific_energy, size, partner=partner))
     n = len(ids)
+    t10_model = float(material.t10_model(specific_energy, size, partner))
     result = {"specific_energy": specific_energy, "particles": n,
               "broken_fraction": len(broken) / n, "model_probability": p_model,
-              "binomial_sigma": float(np.sqrt(p_model * (1 - p_model) / n))}
+              "binomial_sigma": float(np.sqrt(p_model * (1 - p_model) / n)),
+              "t10_model": t10_model if np.isfinite(t10_model) else None}
     if material.is_ab_t10:
         # the e_cum the intact particles carry: what the broken ones would have reached
         broken_ids = {e["id"] for e in broken}
@@ -84,55 +92,100 @@ def breakage_result(brk, ids, material, size, specific_energy, partner):
         if e_cum:
             result["e_cum_measured"] = float(np.mean(e_cum))
             result["p_of_e_cum_measured"] = float(material.fracture_energy_cdf(np.mean(e_cum), size))
-    if broken:
-        parent_mass = sum(e["mass"] for e in broken)
-        sieves = size * np.geomspace(1e-3, 0.99, 40)    # below the feed size: progeny only
-        t10_events = np.array([e["t10"] for e in broken])
-        passing = 100 * brk.size_distribution(sieves).passing_mass / parent_mass
-        result.update({
-            "t10_simulated": float(100 * brk.size_distribution([size / 10]).passing_mass[0]
-                                   / parent_mass),
-            "t10_model": float(t10_events.mean()),
-            "relative_sizes": (sieves / size).tolist(),
-            "progeny_passing_simulated": passing.tolist(),
-            "progeny_passing_model": model.progeny_passing(
-                t10_events, material.beta_params, sieves / size).mean(axis=0).tolist()})
+    if not broken:
+        result["t10_note"] = "no particle broke: no progeny to measure"
+        return result
+    parent_mass = sum(e["mass"] for e in broken)
+    sieves = size * np.geomspace(1e-3, 0.99, 40)    # below the feed size: progeny only
+    passing = 100 * brk.size_distribution(sieves).passing_mass / parent_mass
+    markers = 100 * brk.size_distribution(size / np.array(MARKERS)).passing_mass / parent_mass
+    result.update({
+        "t10_simulated": float(markers[MARKERS.index(10.0)]),
+        "t10_primary_events": float(np.mean([e["t10"] for e in broken])),
+        "breakage_events_all_generations": len(brk.breakage_events),
+        "progeny_markers": {f"t{n:g}": {"simulated": float(sim), "model": _t_n(material, t10_model, n)}
+                            for n, sim in zip(MARKERS, markers)},
+        "relative_sizes": (sieves / size).tolist(),
+        "progeny_passing_simulated": passing.tolist(),
+        "progeny_passing_model": (model.progeny_passing(t10_model, material.beta_params,
+                                                        sieves / size).tolist()
+                                  if np.isfinite(t10_model) else None)})
     return result
 
 
+def result_line(result):
+    """One progress line for an energy: broken fraction and t10 against the model."""
+    line = (f"{result['specific_energy']:g} J/kg: {100 * result['broken_fraction']:.1f} % broken "
+            f"(model {100 * result['model_probability']:.1f} %)")
+    if result.get("t10_simulated") is None:
+        return line + f", no t10 ({result.get('t10_note', 'no model value')})"
+    model_t10 = result["t10_model"]
+    return line + (f", t10 {result['t10_simulated']:.2f} % (model "
+                   f"{'-' if model_t10 is None else f'{model_t10:.2f}'} %)")
+
+
+def _t_n(material, t10, n):
+    """Eq. 10's t_n (%) at t10 (%), with t10 itself for n = 10."""
+    if not np.isfinite(t10):
+        return None
+    if n == 10.0:
+        return float(t10)
+    return float(model.t_n(t10, *material.beta_params[n]))
+
+
 def plot_breakage(results, material, size, partner, title, path, label="simulation"):
-    """Broken fraction against specific energy (model line, simulation with 3 sigma) and the
-    progeny size distributions (model lines, simulation symbols), to a PNG."""
+    """Three panels to a PNG: broken fraction against specific energy (model line, simulation
+    with 3 sigma); t10 against specific energy (the model's Eq. 7 or 9.4 from 50 to 3,000 J/kg
+    and beyond the energies run, the simulation, the primary events' mean t10'); the progeny
+    size distributions (model lines, simulation symbols)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    fig, axes = plt.subplots(1, 3, figsize=(17, 4.8))
     energies = [r["specific_energy"] for r in results]
-    grid = np.geomspace(min(energies) / 3, max(energies) * 3, 200)
-    axes[0].semilogx(grid, 100 * material.breakage_probability(grid, size, partner=partner), "k-",
-                     label=("model P(e_cum), e_cum = e Ek/mp - e_min (Eqs. 4, 9.1-9.3)"
-                            if material.is_ab_t10 else "model (Eqs. 1-4)"))
-    measured = [(r["specific_energy"], r["p_of_e_cum_measured"]) for r in results
-                if "p_of_e_cum_measured" in r]
-    if measured:
-        axes[0].plot(*zip(*[(e, 100 * p) for e, p in measured]), "kx", ms=8,
-                     label="P(e_cum) at the e_cum measured")
-    axes[0].errorbar(energies, [100 * r["broken_fraction"] for r in results],
-                     yerr=[300 * r["binomial_sigma"] for r in results], fmt="o", c="C3",
-                     label=f"{label} (3 sigma)")
-    axes[0].set(xlabel="specific energy Ek/mp (J/kg)", ylabel="broken (%)", title=title)
-    axes[0].legend(loc="upper left", fontsize=8)
+    _plot_probability(axes[0], results, material, size, partner, energies, title, label)
+    grid = np.geomspace(min(50.0, min(energies) / 2), max(3000.0, 2 * max(energies)), 200)
+    axes[1].semilogx(grid, material.t10_model(grid, size, partner), "k-",
+                     label="model: Eq. 9.4" if material.is_ab_t10 else
+                     "model: Eq. 7, e Ek/mp over E50b of the broken particles")
+    done = [r for r in results if r.get("t10_simulated") is not None]
+    if done:
+        axes[1].plot([r["specific_energy"] for r in done], [r["t10_simulated"] for r in done],
+                     "o", c="C3", label=f"{label}: progeny t10, all generations")
+        axes[1].plot([r["specific_energy"] for r in done], [r["t10_primary_events"] for r in done],
+                     "x", c="C0", label="mean t10' of the primary breakages (Eq. 8)")
+    axes[1].set(xlabel="specific energy Ek/mp (J/kg)", ylabel="t10 (%)",
+                title="t10 against the model at each energy")
+    axes[1].legend(fontsize=7, loc="upper left")
     for k, r in enumerate(results):
-        if "relative_sizes" in r:
-            axes[1].semilogx(r["relative_sizes"], r["progeny_passing_model"], "-", c=f"C{k}",
-                             label=f"model, {r['specific_energy']:g} J/kg")
-            axes[1].semilogx(r["relative_sizes"], r["progeny_passing_simulated"], "o", ms=4,
-                             c=f"C{k}", label=f"simulation, t10 {r['t10_simulated']:.1f} % "
-                                              f"({'Eq. 9.4' if material.is_ab_t10 else 'Eq. 8'}: "
-                                              f"{r['t10_model']:.1f} %)")
-    axes[1].set(xlabel="relative size d / d_parent", ylabel="progeny passing (%)",
+        if "relative_sizes" not in r:
+            continue
+        if r["progeny_passing_model"] is not None:
+            axes[2].semilogx(r["relative_sizes"], r["progeny_passing_model"], "-", c=f"C{k}",
+                             label=f"model, {r['specific_energy']:g} J/kg (t10 "
+                                   f"{r['t10_model']:.1f} %)")
+        axes[2].semilogx(r["relative_sizes"], r["progeny_passing_simulated"], "o", ms=4,
+                         c=f"C{k}", label=f"simulation, t10 {r['t10_simulated']:.1f} %")
+    axes[2].set(xlabel="relative size d / d_parent", ylabel="progeny passing (%)",
                 title="progeny of broken particles (fines included)")
-    axes[1].legend(fontsize=7)
+    axes[2].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def _plot_probability(ax, results, material, size, partner, energies, title, label):
+    grid = np.geomspace(min(energies) / 3, max(energies) * 3, 200)
+    ax.semilogx(grid, 100 * material.breakage_probability(grid, size, partner=partner), "k-",
+                label=("model P(e_cum), e_cum = e Ek/mp - e_min (Eqs. 4, 9.1-9.3)"
+                       if material.is_ab_t10 else "model (Eqs. 1-4)"))
+    measured = [(r["specific_energy"], r["p_of_e_cum_measured"]) for r in results
+                if "p_of_e_cum_measured" in r]
+    if measured:
+        ax.plot(*zip(*[(e, 100 * p) for e, p in measured]), "kx", ms=8,
+                label="P(e_cum) at the e_cum measured")
+    ax.errorbar(energies, [100 * r["broken_fraction"] for r in results],
+                yerr=[np.clip(300 * r["binomial_sigma"], 0.0, None) for r in results], fmt="o",
+                c="C3", label=f"{label} (3 sigma)")
+    ax.set(xlabel="specific energy Ek/mp (J/kg)", ylabel="broken (%)", title=title)
+    ax.legend(loc="upper left", fontsize=8)
