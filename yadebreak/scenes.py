@@ -57,25 +57,26 @@ def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None):
     not stop when the original particles have broken (it used to, and high-energy impacts lost
     their successive breakage).
 
-    The fragments are done when none heads for the plate faster than 10 % of the fastest listed
+    The fragments are done (at once if nothing was fired: no impact) when none heads for the plate faster than 10 % of the fastest listed
     body's initial speed (1 % of the impact's specific energy), or, with the controller `brk`,
     when none has broken for five Hertz loading times of the listed bodies at that speed (the
     cascade is over; what is still flying back is slow: measured, 200,000 steps of a fragment
     cloud's tail at 1000 J/kg added no breakage)."""
-    speed = max((O.bodies[i].state.vel.norm() for i in ids), default=0.0)
-    quiet = 5.0 * _loading_time(ids[0], speed) if brk is not None and ids and speed > 0 else None
+    fired = [O.bodies[i] for i in ids if i < len(O.bodies) and O.bodies[i] is not None]
+    speed = max((b.state.vel.norm() for b in fired), default=0.0)
+    quiet = (5.0 * _loading_time(fired[0], speed) if brk is not None and fired and speed > 0
+             else None)
     done_steps = 0
     while done_steps < max_steps:
         run_steps(check_every)
         done_steps += check_every
-        if all(_left(i) for i in ids) and (_all_away(0.1 * speed)
+        if all(_left(i) for i in ids) and (speed == 0.0 or _all_away(0.1 * speed)
                                            or (quiet and O.time - _last_breakage(brk) > quiet)):
             break
     return done_steps
 
 
-def _loading_time(bid, speed):
-    b = O.bodies[bid]
+def _loading_time(b, speed):
     return float(placement.hertz_loading_time(b.shape.radius, b.material.density, b.material.young,
                                               b.material.poisson, speed))
 
