@@ -183,7 +183,7 @@ def run_case(case, fast=False):
     # replacement must keep at zero, the rigid field of a body at rest)
     kinetic_before = _kinetic(brk)
     mass_before = brk.total_mass()
-    steps = scenes.run_until_rebound(ids, max_steps=case.max_steps, brk=brk)
+    steps = scenes.run_until_rebound(ids, max_steps=case.max_steps)
     # then on until no collision is left: nothing touches, or the kinetic energy no longer changes
     # over 500 steps (fragments flying apart, or clusters moving or resting as one)
     ended = False
