@@ -6,4 +6,9 @@ ensure_yade_importable()
 import yade.wrapper as wrapper  # noqa: E402
 from yade import O, utils  # noqa: E402
 
-__all__ = ["O", "utils", "wrapper"]
+__all__ = ["O", "find_engine", "utils", "wrapper"]
+
+
+def find_engine(label):
+    """The engine of O.engines with this label, or None."""
+    return next((e for e in O.engines if getattr(e, "label", "") == label), None)

@@ -5,7 +5,7 @@ import json
 import os
 from pathlib import Path
 
-from ._yade import O, wrapper
+from ._yade import O, find_engine, wrapper
 from .config import AttachError, Config
 from .controller import Controller
 from .scene_materials import breakable_spheres, resolve
@@ -17,10 +17,6 @@ _TAG = "yadebreak:"
 _SCRIPT_TAG = "yadebreak_script"
 #: YADE's O.dt before anyone sets it: any other value before attach() is the user's
 YADE_DEFAULT_DT = 1e-8
-
-
-def _find_engine(label):
-    return next((e for e in O.engines if getattr(e, "label", "") == label), None)
 
 
 def _runner(command, label, runner_label, period, dead=False):
@@ -42,7 +38,7 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     chooses its criterion (breakage.model = "tavares" or "ab_t10"); one scene may mix both.
     """
     config = Config.from_options(seed=seed, **options)
-    if label in _ENGINES and _find_engine(label) is not None:
+    if label in _ENGINES and find_engine(label) is not None:
         raise AttachError(f"yadebreak is already attached to this scene as '{label}': call attach "
                           "once per scene (or give another label)")
     engines = list(O.engines)
@@ -110,7 +106,7 @@ def _runs(label):
     """How many times the engine's two PyRunners have run. The state stored with the scene is
     current only if neither has run since, but for the call that restores it (YADE counts a
     run before the runner's command)."""
-    return [getattr(_find_engine(name), "nDone", 0) for name in (label, label + "_zero")]
+    return [getattr(find_engine(name), "nDone", 0) for name in (label, label + "_zero")]
 
 
 def _store(ctl):
@@ -139,7 +135,7 @@ def _restore(label):
     table = state.table
     ctl.smallest.rebuild((float(table.columns["radius"][i]), i) for i in state.tracked
                          if table.columns["kind"][i] == BREAKABLE)
-    engine = _find_engine(label)
+    engine = find_engine(label)
     ctl.schedule.period = engine.iterPeriod if engine is not None else 1
     ctl.schedule.restore(data["fast"])
     ctl.reader.restore(data["contacts"])

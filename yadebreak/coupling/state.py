@@ -56,12 +56,6 @@ class BodyTable:
         self.columns = {name: np.empty(0, dtype) for name, (dtype, _) in _COLUMNS.items()}
         self.known = {}                       # id -> None, in the order bodies were adopted
 
-    def __getattr__(self, name):              # table.fracture_energy -> the column
-        try:
-            return self.__dict__["columns"][name]
-        except KeyError:
-            raise AttributeError(name) from None
-
     def _grow(self, top):
         if top < self.size:
             return
@@ -223,8 +217,6 @@ class EventLog:
 class FinesLedger:
     """Dummy fines kept outside the DEM (dummies="ledger"): per entry its mass (kg), the parent's
     diameter (m), the event's t10' (%), material label and momentum (kg m/s)."""
-
-    FIELDS = ("mass", "parent_size", "t10", "material", "momentum")
 
     def __init__(self, entries=()):
         self.entries = [dict(e) for e in entries]

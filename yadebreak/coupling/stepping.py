@@ -6,7 +6,7 @@ import heapq
 import math
 
 from .. import placement
-from ._yade import O, wrapper
+from ._yade import O, find_engine, wrapper
 
 #: read_period="fast" never waits longer than this many steps between reads.
 FAST_MAX_PERIOD = 200
@@ -107,7 +107,7 @@ class ReadSchedule:
     def set_period(self, k):
         if k != self.period:
             self.period = k
-            _engine(self.engine_label).iterPeriod = k
+            find_engine(self.engine_label).iterPeriod = k
 
     def remedy(self):
         """The option that makes reads closer, for the warning that a read came late."""
@@ -227,7 +227,3 @@ class FragmentDamping:
             else:
                 keep.append((until, ids))
         self.until = keep
-
-
-def _engine(label):
-    return next(e for e in O.engines if getattr(e, "label", "") == label)

@@ -8,7 +8,7 @@ separates. The work per step is bounded by the zeroed pairs; the engine sleeps w
 """
 from __future__ import annotations
 
-from ._yade import O, utils, wrapper
+from ._yade import O, find_engine, utils, wrapper
 
 
 class ZeroedOverlap:
@@ -76,13 +76,13 @@ class OverlapZeroing:
 
     def wake(self):
         if self.pairs:
-            _engine(self.engine_label).dead = False
+            find_engine(self.engine_label).dead = False
 
     def apply(self):
         """Before the InteractionLoop: scale kno, kso of every zeroed pair (sphere pairs from this
         step's positions, walls and facets from the last step's overlap)."""
         if not self.pairs:
-            _engine(self.engine_label).dead = True
+            find_engine(self.engine_label).dead = True
             return
         cache = self._cache
         done = []
@@ -132,7 +132,3 @@ class OverlapZeroing:
     def restore(self, rows):
         for a, b, *values in rows:
             self._register((a, b), ZeroedOverlap(*values))
-
-
-def _engine(label):
-    return next(e for e in O.engines if getattr(e, "label", "") == label)
