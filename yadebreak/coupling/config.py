@@ -98,6 +98,9 @@ OPTIONS = (
            "share of a fragment's artificial overlap released as real force"),
     Option("zero_overlaps", "replacement", True, _boolean, "True or False", "-",
            "zero the artificial overlaps of fresh fragments (False only to show what it prevents)"),
+    Option("zeroing_tolerance", "replacement", 0.05, _number(0, 1, hi_open=True), "[0, 1)", "-",
+           "a zeroed pair that opens with no force is revisited only when its overlap may have "
+           "shrunk by this share of itself (0: every step)"),
     Option("family_seed", "replacement", 0, _count(0), "an integer >= 0", "-",
            "seed of the family tables (not of the run: that is `seed`)"),
     # time step and fragment damping
@@ -142,6 +145,7 @@ class Replacement:
     dummies: str
     local_damping: float
     zero_overlaps: bool
+    zeroing_tolerance: float
     family_seed: int
 
 

@@ -35,6 +35,16 @@ class ContactRecord:
         self.time_before = self.time_read = now
         self.geom, self.phys = geom, phys
 
+    def start_here(self):
+        """Count work from the present state on, not from first touch: a contact that a fresh
+        fragment inherited overlapping (with a neighbour or a sibling) did no work on it yet;
+        counted from zero, its whole overlap, artificial part included, would count as if the
+        fragment had just been loaded through it."""
+        self.overlap = self.overlap_before = self.geom.penetrationDepth
+        self.force = self.phys.normalForce.norm()
+        self.shear_disp = self.phys.usTotal.norm()
+        self.shear_force = self.phys.shearForce.norm()
+
     def total(self, cs):
         """Normal plus cs times shear work (Eq. 14), J."""
         return self.work + cs * self.shear_work
@@ -124,12 +134,16 @@ class ContactReader:
         self.cs = cs
         self.emin = emin
         self.contacts = {}                            # (id1, id2) -> ContactRecord
+        self.inherited = set()                        # (smaller id, larger id): see inherit()
         self.law = HertzMindlinWork()
 
-    def read(self, interactions, bodies, tracked, zeroed, now, interval):
+    def read(self, interactions, bodies, tracked, zeroed, now, interval, asleep=()):
         """One pass over the interactions; contacts that ceased drop out. `zeroed` holds the pairs
-        whose kno varies; `interval` is the steps since the last read."""
+        whose kno varies, `asleep` those of them (as (smaller id, larger id): YADE's id1 may be
+        the larger) that carry no force and are not visited now (their records stay as they
+        were: they do no work); `interval` is the steps since the last read."""
         cs, emin = self.cs, self.emin
+        inherited = self.inherited
         work_loading, work_to_peak = self.law.loading, self.law.to_peak
         first_touch = self.law.first_touch_factor(interval)
         contacts = self.contacts
@@ -145,43 +159,49 @@ class ContactReader:
                 continue
             key = (a, b)
             c = contacts.get(key)
+            update = True
             if c is None:
                 c = self._new_record(i, bodies, now)
                 if c is None:
                     continue
                 contacts[key] = c
+                if inherited and ((a, b) if a < b else (b, a)) in inherited:
+                    c.start_here()
             elif c.geom is None:                  # restored from a save: YADE's objects again
                 c.geom, c.phys = i.geom, i.phys
-            g = c.geom
-            delta = g.penetrationDepth
-            force = c.phys.normalForce.norm()    # compressive while the overlap grows
-            d0 = c.overlap
-            peaked = delta < d0 and c.overlap_before < d0 and c.time_read > c.time_before
-            if delta > d0 or peaked:
-                hertz = not (zeroed and ((a, b) in zeroed or (b, a) in zeroed))
-                if delta > d0:
-                    work = work_loading(c, delta, force, hertz, first_touch)
-                else:
-                    work = work_to_peak(c, delta, now, hertz)
-                if work is not None:
-                    c.work += work
-                    if in_a:
-                        grew.add(a)
-                    if in_b:
-                        grew.add(b)
-            c.overlap_before = d0
-            c.time_before = c.time_read
-            c.time_read = now
-            c.overlap = delta
-            c.force = force
-            if cs > 0.0:
-                ph = c.phys
-                us = ph.usTotal.norm()
-                fs = ph.shearForce.norm()
-                if us > c.shear_disp:
-                    c.shear_work += 0.5 * (c.shear_force + fs) * (us - c.shear_disp)
-                c.shear_disp = us
-                c.shear_force = fs
+            elif asleep and ((a, b) if a < b else (b, a)) in asleep:
+                update = False                    # a slack zeroed pair: no force, no work
+            if update:
+                g = c.geom
+                delta = g.penetrationDepth
+                force = c.phys.normalForce.norm()    # compressive while the overlap grows
+                d0 = c.overlap
+                peaked = delta < d0 and c.overlap_before < d0 and c.time_read > c.time_before
+                if delta > d0 or peaked:
+                    hertz = not (zeroed and ((a, b) in zeroed or (b, a) in zeroed))
+                    if delta > d0:
+                        work = work_loading(c, delta, force, hertz, first_touch)
+                    else:
+                        work = work_to_peak(c, delta, now, hertz)
+                    if work is not None:
+                        c.work += work
+                        if in_a:
+                            grew.add(a)
+                        if in_b:
+                            grew.add(b)
+                c.overlap_before = d0
+                c.time_before = c.time_read
+                c.time_read = now
+                c.overlap = delta
+                c.force = force
+                if cs > 0.0:
+                    ph = c.phys
+                    us = ph.usTotal.norm()
+                    fs = ph.shearForce.norm()
+                    if us > c.shear_disp:
+                        c.shear_work += 0.5 * (c.shear_force + fs) * (us - c.shear_disp)
+                    c.shear_disp = us
+                    c.shear_force = fs
             seen[key] = c
             total = c.work + cs * c.shear_work
             # both endpoints written out, not looped: this runs for every contact at every read
@@ -192,7 +212,7 @@ class ContactReader:
                     share = c.share_a * own
                     energy[a] = energy.get(a, 0.0) + share
                     if share > strongest.get(a, (0.0,))[0]:
-                        strongest[a] = (share, g.normal, 1.0)      # normal points a -> b
+                        strongest[a] = (share, c.geom.normal, 1.0)      # normal points a -> b
             if in_b:
                 touching.setdefault(b, []).append((c, 1))
                 own = total - c.offset_b
@@ -200,9 +220,15 @@ class ContactReader:
                     share = c.share_b * own
                     energy[b] = energy.get(b, 0.0) + share
                     if share > strongest.get(b, (0.0,))[0]:
-                        strongest[b] = (share, g.normal, -1.0)
+                        strongest[b] = (share, c.geom.normal, -1.0)
         self.contacts = seen
+        inherited.clear()                 # read now or gone
         return out
+
+    def inherit(self, pairs):
+        """Pairs (ids) that fresh fragments inherit overlapping: their records, made at the next
+        read, count work from that state on (ContactRecord.start_here)."""
+        self.inherited.update((a, b) if a < b else (b, a) for a, b in pairs)
 
     def _new_record(self, inter, bodies, now):
         """A record for a contact seen for the first time, with Eq. 4's shares (None while YADE
@@ -246,9 +272,11 @@ class ContactReader:
 
     def to_dict(self):
         return {"fields": list(ContactRecord.SAVED),
-                "rows": [[a, b, *c.saved()] for (a, b), c in self.contacts.items()]}
+                "rows": [[a, b, *c.saved()] for (a, b), c in self.contacts.items()],
+                "inherited": sorted(self.inherited)}
 
     def restore(self, data):
         if data["fields"] != list(ContactRecord.SAVED):
             raise ValueError("saved contacts have other fields than this yadebreak's")
         self.contacts = {(row[0], row[1]): ContactRecord.restored(row[2:]) for row in data["rows"]}
+        self.inherited = {tuple(pair) for pair in data.get("inherited", ())}

@@ -44,7 +44,8 @@ class Controller:
                             for lab, crit in self.criteria.items()}
         self.reader = ContactReader(scene_materials.stiffness_by_id, config.reading.cs,
                                     config.reading.emin)
-        self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero")
+        self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero",
+                                      config.replacement.zeroing_tolerance)
         self.smallest = SmallestBreakable()
         self.schedule = ReadSchedule(config.reading, label, self._smallest_breakable)
         self.time_step = TimeStep(config.time_step.time_step_fraction, self._warn_once)
@@ -53,8 +54,9 @@ class Controller:
         tables = {lab: families.table_for(mat, config.replacement.family_seed)
                   for lab, mat in self.material.items()}
         self.replacer = Replacer(config.replacement, self.state.table, self.state.rng,
-                                 self.criteria, tables, self.zeroing, self.state.ledger,
-                                 self.pause_steps, config.time_step.global_damping > 0.0)
+                                 self.criteria, tables, self.zeroing, self.reader,
+                                 self.state.ledger, self.pause_steps,
+                                 config.time_step.global_damping > 0.0)
         self.judge = Judge(self.state, self._criterion_of, self.reader,
                            config.criteria.fragments_energy_factor,
                            any(self.pause_steps.values()), config.reading.fast_tolerance,
@@ -163,7 +165,7 @@ class Controller:
         t0 = time.perf_counter()
         interval = max(1, O.iter - self.last_iter)        # steps since the last read
         loading = self.reader.read(O.interactions, O.bodies, state.tracked, self.zeroing.pairs,
-                                   O.time, interval)
+                                   O.time, interval, self.zeroing.asleep)
         self.wall_time["read"] += time.perf_counter() - t0
         broken, limits = self.judge.judge(loading, interval, O.iter, self.schedule.mode == "fast")
         if broken:

@@ -58,14 +58,15 @@ def _sphere_body(material, center, radius, mass, vel, angvel, damped):
 class Replacer:
     """Replaces broken spheres; one per engine."""
 
-    def __init__(self, options, table, rng, criteria, families, zeroing, ledger, pause_steps,
-                 damped):
+    def __init__(self, options, table, rng, criteria, families, zeroing, reader, ledger,
+                 pause_steps, damped):
         self.options = options         # config.Replacement
         self.table = table
         self.rng = rng
         self.criteria = criteria       # material label -> criterion
         self.families = families       # material label -> families.FamilyTable
         self.zeroing = zeroing
+        self.reader = reader           # told which contacts the fragments inherit
         self.ledger = ledger
         self.pause_steps = pause_steps  # material label -> steps
         self.damped = damped           # fragments start damped (global damping)
@@ -142,11 +143,14 @@ class Replacer:
         parent, the child overlapping it most keeps the parent's real overlap as real force and
         everything beyond it is zeroed, while the other children's overlaps with that neighbour
         are zeroed entirely (else k children would each press with the parent's overlap and
-        multiply the force the parent carried)."""
+        multiply the force the parent carried). Every overlapping pair is inherited: the reader
+        counts its work from now on."""
         zero = self.zeroing.zero_pair
+        inherited = []
         ii, jj, overlap = placement.overlapping_pairs(centers, radii)
         for a, b, ov in zip(ii, jj, overlap):
             zero(ids[a], ids[b], float(ov), created=False)
+            inherited.append((ids[a], ids[b]))
         for other, real in neighbours:
             ob = O.bodies[other]
             if ob is None:
@@ -163,9 +167,11 @@ class Replacer:
                 continue
             keeper = touching[np.argmax(ov[touching])]
             for k in touching:
+                inherited.append((ids[k], other))
                 artificial = ov[k] - real if k == keeper else ov[k]
                 if artificial > 0.0:
                     zero(ids[k], other, float(artificial), created=created)
+        self.reader.inherit(inherited)
 
 
 def _overlap_with(fragment, other):
