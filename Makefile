@@ -7,7 +7,9 @@ OUT ?= out
 
 .PHONY: deps demo model-demo test test-model bench
 
-# apt-get only when something is missing, so repeated runs start at once.
+# apt-get only when something is missing, so repeated runs start at once. Then `import yadebreak`
+# is made to work from any folder (a user's own scenes) under /usr/bin/python3 and yade: see
+# LINK_PACKAGE.
 deps:
 	@if ! command -v yade >/dev/null 2>&1 || ! $(PY) -c "import pytest, numpy, scipy, matplotlib; \
 		from yadebreak.yadepath import ensure_yade_importable as ok; assert ok()" >/dev/null 2>&1; then \
@@ -15,6 +17,22 @@ deps:
 		apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q \
 			yade python3-yade python3-pytest python3-numpy python3-scipy python3-matplotlib; \
 	fi
+	@$(PY) -c "$$LINK_PACKAGE" "$(CURDIR)"
+
+# A one-line yadebreak.pth naming this checkout, in the site folder of /usr/bin/python3 that pip
+# would use (/usr/local/lib/python3.X/dist-packages as root, the user's own site folder otherwise):
+# no pip, no network, no build files in the checkout; rewritten only when it names another folder.
+define LINK_PACKAGE
+import os, site, sys
+folder = site.getsitepackages()[0] if os.geteuid() == 0 else site.getusersitepackages()
+path, line = os.path.join(folder, "yadebreak.pth"), sys.argv[1] + "\n"
+if not os.path.exists(path) or open(path).read() != line:
+    os.makedirs(folder, exist_ok=True)
+    with open(path, "w") as f:
+        f.write(line)
+    print(f"[yadebreak] wrote {path}: import yadebreak now works from any folder")
+endef
+export LINK_PACKAGE
 
 demo: deps
 	yade -n -x scripts/bed_impact.py --out $(OUT)/bed_impact

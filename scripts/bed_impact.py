@@ -6,7 +6,8 @@ cylindrical holder removed at the first touch). Default: copper ore, 3 rings, 1 
 
     yade -n scripts/bed_impact.py                    # run, then the YADE prompt for inspection
     yade -n -x scripts/bed_impact.py --rings 2 --energy 2   # headless
-Writes summary.json, events.jsonl, size_distribution.csv, plots and a VTK file into --out, and
+Writes summary.json, events.jsonl, size_distribution.csv, plots and a ParaView time series
+(paraview/spheres.pvd, surfaces.pvd) into --out, and
 checkpoint.yade.gz every --checkpoint-every seconds: `--resume 1` continues a run that died.
 """
 import sys
@@ -14,14 +15,39 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.scriptargs import script_params  # noqa: E402
+from yadebreak.scriptargs import choice, flag, integer, number, script_params, text  # noqa: E402
 
-args = script_params(dict(material="copper_ore", size=5.5e-3, rings=3, layers=1, energy=3.05,
-                          speed=0.0, seed=1, time_step_fraction=0.05, dmin=0.0,
-                          global_damping=0.0, dummies="ledger", read_period="fast", max_time=0.02,
-                          checkpoint_every=60.0, resume=False, out="out/bed_impact"), __doc__)
+args = script_params([
+    text("material", "copper_ore", "material of the bed: a name of the library or a .toml file"),
+    number("size", 5.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1),
+    integer("rings", 3, "hexagonal rings around the central particle", lo=0),
+    integer("layers", 1, "layers of particles (more than one: held by a holder until the touch)",
+            lo=1),
+    number("energy", 3.05, "J", "impact energy of the ball (not per kg)", lo=0, lo_open=True),
+    number("speed", 0.0, "m/s", "the ball's speed instead of --energy (0: from --energy)", lo=0),
+    integer("seed", 1, "random seed", lo=0),
+    number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest sphere's "
+           "Rayleigh time", lo=0, lo_open=True, hi=1),
+    number("dmin", 0.0, "m", "fragments whose progeny would be finer never break "
+           "(0: particle size / 20)", lo=0),
+    number("global_damping", 0.0, "-", "Newton damping of fresh fragments (0: none)", lo=0, hi=1,
+           hi_open=True),
+    choice("dummies", "ledger", ("ledger", "spheres"), "the unresolved fines: a mass ledger, or "
+           "dummy spheres (the paper)"),
+    integer("read_period", "fast", "how often contacts are read: every k steps, 'auto' or 'fast'",
+            lo=1, words=("auto", "fast"), unit="steps"),
+    number("max_time", 0.02, "s", "simulated time at which the run stops at the latest", lo=0,
+           lo_open=True),
+    number("vtk_interval", 1e-4, "s", "simulated time between frames of the ParaView series in "
+           "<out>/paraview (0: no series)", lo=0),
+    number("checkpoint_every", 60.0, "s", "wall time between checkpoints (< 0: none)"),
+    flag("resume", False, "continue the run that died in --out from its checkpoint"),
+    number("stop_after", 0.0, "s", "(tests) end as if killed at this simulated time (0: never)",
+           lo=0),
+    text("out", "out/bed_impact", "output folder"),
+], __doc__)
 
 from yadebreak import bed  # noqa: E402
 from yadebreak.scriptargs import run_script  # noqa: E402
 
-brk, result = run_script(bed.run, args)
+brk, result = run_script(bed.run, args) or (None, None)   # None: resumed a finished run

@@ -14,19 +14,34 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 
 
 from yadebreak import load_material, reports  # noqa: E402
-from yadebreak.scriptargs import PartialResults, progress, script_params  # noqa: E402
+from yadebreak.scriptargs import (PartialResults, flag, integer, number, numbers,  # noqa: E402
+                                  progress, run_script, script_params, text)
 
-args = script_params(dict(material="copper_ore", size=5.5e-3, particles=60, seed=1,
-                          energies="150,600", striker_mass_ratio=50.0, time_step_fraction=0.05,
-                          max_time=0.003, out="out/drop_weight", resume=False,
-                          stop_after=0), __doc__)
+args = script_params([
+    text("material", "copper_ore", "material of the particles: a name of the library or a .toml "
+         "file"),
+    number("size", 5.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1),
+    integer("particles", 60, "particles tested at each energy", lo=1),
+    integer("seed", 1, "random seed of the first energy (the next ones: +1, +2, ...)", lo=0),
+    numbers("energies", "150,600", "J/kg", "specific energies of the striker's fall per particle "
+            "mass", lo=0, lo_open=True),
+    number("striker_mass_ratio", 50.0, "-", "striker mass over particle mass", lo=0, lo_open=True),
+    number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest sphere's "
+           "Rayleigh time", lo=0, lo_open=True, hi=1),
+    number("max_time", 0.003, "s", "simulated time per energy at the most", lo=0, lo_open=True),
+    text("out", "out/drop_weight", "output folder"),
+    flag("resume", False, "continue the run in --out, keeping the energies it finished"),
+    integer("stop_after", 0, "(tests) end as if killed after this many energies (0: never)", lo=0,
+            unit="energies"),
+], __doc__)
 
 from yade import O  # noqa: E402
 from yadebreak import coupling, scenes  # noqa: E402
-from yadebreak.scriptargs import run_script  # noqa: E402
 
 
 def main(args):
+    """Every energy, then summary.json and the plot; returns the last energy's controller."""
+    brk = None
     mat, steel = load_material(args.material), load_material("steel")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -54,7 +69,9 @@ def main(args):
                                                   "runtime_s": time.time() - start}, indent=2))
     reports.plot_breakage(results, mat, args.size, steel, f"{mat.name} drop weight",
                           out / "drop_weight.png", label="drop weight, simulation")
+    partial.finish()
     progress(f"wrote {out / 'summary.json'} and {out / 'drop_weight.png'}")
+    return brk
 
 
-run_script(main, args)
+brk = run_script(main, args)      # the last scene's controller, at the prompt without -x

@@ -20,9 +20,11 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 from yadebreak.scriptargs import progress  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-parser.add_argument("--out", default="out/extremes")
-parser.add_argument("--fast", action="store_true", help="the test suite's particle counts")
-parser.add_argument("--only", default="", help="run the cases whose name contains this text")
+parser.add_argument("--out", default="out/extremes", help="output folder; default out/extremes")
+parser.add_argument("--fast", action="store_true",
+                    help="the test suite's particle counts; default off")
+parser.add_argument("--only", default="",
+                    help="run the cases whose name contains this text; default all cases")
 args, _ = parser.parse_known_args()
 
 from yadebreak import extremes  # noqa: E402

@@ -14,8 +14,10 @@ from pathlib import Path
 import numpy as np
 
 parser = argparse.ArgumentParser(description=__doc__)
-parser.add_argument("--sweep", default="out/sweep")
-parser.add_argument("--out", default="out/sweep_report")
+parser.add_argument("--sweep", default="out/sweep",
+                    help="folder of the yade-batch runs; default out/sweep")
+parser.add_argument("--out", default="out/sweep_report",
+                    help="output folder; default out/sweep_report")
 args = parser.parse_args()
 
 runs = [json.loads(p.read_text()) for p in sorted(Path(args.sweep).glob("*/summary.json"))]

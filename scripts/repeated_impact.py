@@ -21,20 +21,37 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 import numpy as np  # noqa: E402
 
 from yadebreak import load_material, model  # noqa: E402
-from yadebreak.scriptargs import (check_resume_arguments, progress, resume_arguments,  # noqa: E402
-                                  script_params, stop_if_asked)
+from yadebreak.scriptargs import (ScriptError, check_not_finished,  # noqa: E402
+                                  check_resume_arguments, flag, integer, mark_finished,
+                                  mark_started, number, progress, resume_arguments, run_script,
+                                  script_params, stop_if_asked, text)
 
-args = script_params(dict(material="copper_ore", size=37.5e-3, particles=100, impacts=20,
-                          energy=94.7, gamma=0.0, seed=1, target="steel",
-                          time_step_fraction=0.05, out="out/repeated_impact", resume=False,
-                          stop_after=0), __doc__)
+args = script_params([
+    text("material", "copper_ore", "material of the particles: a name of the library or a .toml "
+         "file"),
+    number("size", 37.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1),
+    integer("particles", 100, "particles", lo=1),
+    integer("impacts", 20, "impacts of each particle", lo=1),
+    number("energy", 94.7, "J/kg", "specific impact energy Ek/mp = v^2/2 of every impact", lo=0,
+           lo_open=True),
+    number("gamma", 0.0, "-", "damage exponent of Eq. 5, replacing the material's (0: the "
+           "material's)", lo=0),
+    integer("seed", 1, "random seed", lo=0),
+    text("target", "steel", "the plate: steel, rubber or a material"),
+    number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest sphere's "
+           "Rayleigh time", lo=0, lo_open=True, hi=1),
+    text("out", "out/repeated_impact", "output folder"),
+    flag("resume", False, "continue the run in --out from the checkpoint after its last impact"),
+    integer("stop_after", 0, "(tests) end as if killed after this many impacts (0: never)", lo=0,
+            unit="impacts"),
+], __doc__)
 
 from yade import O  # noqa: E402
 from yadebreak import coupling, scenes  # noqa: E402
-from yadebreak.scriptargs import ScriptError, run_script  # noqa: E402
 
 
 def main(args):
+    """Every impact, then summary.json and the plot; returns the controller."""
     mat = load_material(args.material)
     if args.gamma > 0:
         if mat.is_ab_t10:
@@ -47,12 +64,14 @@ def main(args):
     start = time.time()
     checkpoint = out / "checkpoint.yade.gz"
     if args.resume:
+        check_not_finished(out, args)     # a finished run: says so, nothing is run or rewritten
         brk, loop = coupling.load_checkpoint(checkpoint)
         check_resume_arguments(loop["arguments"], args, checkpoint)
         ids, alive, fractions = loop["ids"], loop["alive"], loop["fractions"]
         home = {int(i): tuple(p) for i, p in loop["home"].items()}
         progress(f"resumed from {checkpoint} after impact {len(fractions)}")
     else:
+        mark_started(out)
         brk, ids = scenes.impact_scene(mat, args.size, [speed] * args.particles, target=args.target,
                                        seed=args.seed, replace=False,
                                        time_step_fraction=args.time_step_fraction,
@@ -104,7 +123,9 @@ def main(args):
     ax.legend()
     fig.tight_layout()
     fig.savefig(out / "repeated_impact.png", dpi=110)
+    mark_finished(out, args)              # a later --resume 1 says so and does nothing
     progress(f"wrote {out / 'summary.json'} and {out / 'repeated_impact.png'}")
+    return brk
 
 
-run_script(main, args)
+brk = run_script(main, args)      # the controller, at the prompt without -x

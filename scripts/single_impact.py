@@ -19,18 +19,33 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 import numpy as np  # noqa: E402
 
 from yadebreak import load_material, reports  # noqa: E402
-from yadebreak.scriptargs import PartialResults, progress, script_params  # noqa: E402
+from yadebreak.scriptargs import (PartialResults, flag, integer, number, numbers,  # noqa: E402
+                                  progress, run_script, script_params, text)
 
-args = script_params(dict(material="copper_ore", size=5.5e-3, particles=250, seed=1,
-                          target="steel", energies="100,200,400", replace=True,
-                          time_step_fraction=0.05, out="out/single_impact", resume=False,
-                          stop_after=0), __doc__)
+args = script_params([
+    text("material", "copper_ore", "material of the particles: a name of the library or a .toml "
+         "file"),
+    number("size", 5.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1),
+    integer("particles", 250, "particles fired at each energy", lo=1),
+    integer("seed", 1, "random seed of the first energy (the next ones: +1, +2, ...)", lo=0),
+    text("target", "steel", "the plate: steel, rubber or a material"),
+    numbers("energies", "100,200,400", "J/kg", "specific impact energies Ek/mp = v^2/2", lo=0,
+            lo_open=True),
+    flag("replace", True, "replace broken particles by their fragments (0: record events only)"),
+    number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest sphere's "
+           "Rayleigh time", lo=0, lo_open=True, hi=1),
+    text("out", "out/single_impact", "output folder"),
+    flag("resume", False, "continue the run in --out, keeping the energies it finished"),
+    integer("stop_after", 0, "(tests) end as if killed after this many energies (0: never)", lo=0,
+            unit="energies"),
+], __doc__)
 
 from yadebreak import scenes  # noqa: E402
-from yadebreak.scriptargs import run_script  # noqa: E402
 
 
 def main(args):
+    """Every energy, then summary.json and the plot; returns the last energy's controller."""
+    brk = None
     mat, target = load_material(args.material), load_material(args.target)
     share = mat.energy_partition(target)
     out = Path(args.out)
@@ -64,7 +79,9 @@ def main(args):
     reports.plot_breakage(results, mat, args.size, target,
                           f"{mat.name}, {1e3 * args.size:g} mm on {args.target}",
                           out / "single_impact.png")
+    partial.finish()
     progress(f"wrote {out / 'summary.json'} and {out / 'single_impact.png'}")
+    return brk
 
 
-run_script(main, args)
+brk = run_script(main, args)      # the last scene's controller, at the prompt without -x

@@ -23,8 +23,10 @@ import numpy as np  # noqa: E402
 from yadebreak import bed, coupling, load_material, scenes  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
-parser.add_argument("--out", default="out/speed_accuracy")
-parser.add_argument("--quick", action="store_true", help="fewer settings (a few minutes)")
+parser.add_argument("--out", default="out/speed_accuracy",
+                    help="output folder; default out/speed_accuracy")
+parser.add_argument("--quick", action="store_true",
+                    help="fewer settings (a few minutes); default off")
 args = parser.parse_args()
 out = Path(args.out)
 out.mkdir(parents=True, exist_ok=True)

@@ -22,7 +22,7 @@ def test_small_bed_writes_every_output_and_conserves_mass(scene, tmp_path):
     from yadebreak import bed
     brk, summary = bed.run(_args(tmp_path, 0.6), quiet=True)
     for name in ("summary.json", "events.jsonl", "size_distribution.csv", "size_distribution.png",
-                 "bed_top_view.png", "bodies.vtk"):
+                 "bed_top_view.png", "paraview/spheres.pvd", "paraview/surfaces.pvd"):
         assert (tmp_path / name).stat().st_size > 0, name
     saved = json.loads((tmp_path / "summary.json").read_text())
     for key in ("broken_mass", "broken_mass_fraction", "capture_radius", "breakage_events",
@@ -84,3 +84,8 @@ def test_resume_continues_exactly_like_an_uninterrupted_run(scene, tmp_path):
                 "steps", "simulated_time"):
         assert resumed[key] == reference[key], key
     assert (tmp_path / "died" / "events.jsonl").read_text() == reference_events
+
+    def series(out):
+        return {p.name: p.read_text() for p in (out / "paraview").glob("spheres*")}
+    whole_series = series(tmp_path / "whole")   # the .pvd; frames at 0, 1 ms (max_time / 20), end
+    assert len(whole_series) == 4 and series(tmp_path / "died") == whole_series   # frames go on

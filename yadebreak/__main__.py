@@ -1,7 +1,9 @@
-"""Command line: `python -m yadebreak demo | families | materials` (no YADE needed)."""
+"""Command line: `python -m yadebreak demo | families | materials | options` (no YADE needed).
+
+Options are declared as the scripts' are (scriptargs: type, range, unit, default, help); a bad
+value stops with one line naming the option, the value, the range and the unit (exit code 2)."""
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
@@ -10,6 +12,8 @@ import numpy as np
 
 from . import families, model
 from .materials import MaterialError, available_materials, load_material
+from .scriptargs import (DEBUG, ScriptParser, add_params, fail, integer, join_negative_values,
+                         number, read_params, text)
 
 
 def _plt():
@@ -108,29 +112,38 @@ value, the accepted range and the unit. Written by `python3 -m yadebreak options
 """
 
 
+#: each command: (function, help, its options)
+COMMANDS = {
+    "demo": (demo, "plot breakage probability and t10 curves of a material", [
+        text("material", "copper_ore", "a material name or a .toml file"),
+        text("out", "out/demo", "output folder")]),
+    "families": (plot_families, "plot the family set of a t10' (paper Fig. 2)", [
+        text("material", "table1", "a material name, or table1"),
+        number("t10", 3.0, "%", "t10' of the family set", lo=0, lo_open=True, hi=100),
+        integer("seed", 0, "seed of the family generation", lo=0),
+        text("out", "out/families.png", "the plot (PNG)")]),
+    "materials": (list_materials, "list the material library", []),
+    "options": (print_options, "the engine's options as Markdown (docs/options.md)", []),
+}
+
+
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m yadebreak")
+    parser = ScriptParser(prog="python -m yadebreak")
     sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("demo", help="plot breakage probability and t10 curves of a material")
-    p.add_argument("--material", default="copper_ore")
-    p.add_argument("--out", default="out/demo")
-    p.set_defaults(func=demo)
-    p = sub.add_parser("families", help="plot the family set of a t10' (paper Fig. 2)")
-    p.add_argument("--material", default="table1", help="a material name, or table1")
-    p.add_argument("--t10", type=float, default=3.0)
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--out", default="out/families.png")
-    p.set_defaults(func=plot_families)
-    p = sub.add_parser("materials", help="list the material library")
-    p.set_defaults(func=list_materials)
-    p = sub.add_parser("options", help="the engine's options as Markdown (docs/options.md)")
-    p.set_defaults(func=print_options)
-    args = parser.parse_args(argv)
+    for name, (func, what, params) in COMMANDS.items():
+        p = sub.add_parser(name, help=what, description=what)
+        add_params(p, params + [DEBUG])
+        p.set_defaults(func=func, params=params + [DEBUG])
+    argv = sys.argv[1:] if argv is None else list(argv)
+    every = [p for _, _, params in COMMANDS.values() for p in params]
+    args = parser.parse_args(join_negative_values(argv, every))
+    read_params(args, args.params)
     try:
         args.func(args)
     except MaterialError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+        if args.debug:
+            raise
+        fail(f"{exc.source}: " + "; ".join(exc.problems))
     return 0
 
 

@@ -9,9 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import coupling, scenes
-from .coupling._yade import O, wrapper
-from .scriptargs import progress
+from . import coupling, paraview, scenes
+from .coupling._yade import O
+from .scriptargs import (check_not_finished, check_resume_arguments, mark_finished, mark_started,
+                         progress, resume_arguments)
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
 TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
@@ -38,38 +39,19 @@ def capture_radius(brk, info):
     return max(radii) if radii else 0.0
 
 
-def write_vtk(path, brk):
-    """Legacy VTK polydata of every sphere: radius, fracture energy, damage, class."""
-    classes = {"breakable": 0, "unbreakable": 1, "dummy": 2}
-    rows = []
-    for b in O.bodies:
-        if b is None or not isinstance(b.shape, wrapper.Sphere):
-            continue
-        st = brk.bodies.get(b.id)
-        fe = st.fracture_energy if st is not None and math.isfinite(st.fracture_energy) else -1.0
-        rows.append((*b.state.pos, b.shape.radius, fe, st.damage if st else 0.0,
-                     classes.get(st.kind, 3) if st else 3))
-    with open(path, "w") as f:
-        f.write("# vtk DataFile Version 3.0\nyadebreak spheres\nASCII\nDATASET POLYDATA\n")
-        f.write(f"POINTS {len(rows)} double\n")
-        f.writelines(f"{r[0]:.9g} {r[1]:.9g} {r[2]:.9g}\n" for r in rows)
-        f.write(f"POINT_DATA {len(rows)}\n")
-        for k, name in ((3, "radius"), (4, "fracture_energy"), (5, "damage")):
-            f.write(f"SCALARS {name} double 1\nLOOKUP_TABLE default\n")
-            f.writelines(f"{r[k]:.9g}\n" for r in rows)
-        f.write("SCALARS class int 1\nLOOKUP_TABLE default\n")
-        f.writelines(f"{r[6]}\n" for r in rows)
-
-
-def _checkpoint(path, info, loop):
-    """The scene with the loop's own state (see coupling.save_checkpoint)."""
+def _checkpoint(path, info, loop, args):
+    """The scene, the loop's own state and the run's arguments (coupling.save_checkpoint)."""
     coupling.save_checkpoint(path, {
         "loop": loop, "info": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
-                               for k, v in info.items() if k != "material"}})
+                               for k, v in info.items() if k != "material"},
+        "arguments": resume_arguments(args)})
 
 
-def _resume(path):
+def _resume(path, args):
+    """The checkpoint's scene, refused (naming them) if it was run with other arguments."""
     brk, data = coupling.load_checkpoint(path)
+    if "arguments" in data:                 # (checkpoints written before they were recorded: not)
+        check_resume_arguments(data["arguments"], args, path)
     info = data["info"]
     info["centers"] = np.array(info["centers"])
     return brk, info, data["loop"]
@@ -92,9 +74,11 @@ def _start(args, out, energy, say):
     """The scene, new or from the checkpoint (--resume 1): (controller, info, loop state)."""
     checkpoint = out / "checkpoint.yade.gz"
     if getattr(args, "resume", False):
-        brk, info, loop = _resume(checkpoint)
+        check_not_finished(out, args)       # a finished run: says so, nothing is run or rewritten
+        brk, info, loop = _resume(checkpoint, args)
         say(f"resumed from {checkpoint} at t = {1e3 * O.time:.3f} ms, iteration {O.iter}")
         return brk, info, loop
+    mark_started(out)
     brk, info = scenes.bed_impact_scene(args.material, args.size, args.rings, args.layers,
                                         energy, args.seed, **_options(args, out))
     say(f"{len(info['particles'])} particles of {args.material} ({1e3 * args.size:g} mm), "
@@ -102,9 +86,20 @@ def _start(args, out, energy, say):
     return brk, info, {"touched": None, "turned": None, "initial_mass": brk.total_mass()}
 
 
-def _impact(brk, info, loop, args, out, start, say):
-    """Run until the ball has turned plus TAIL of unloading (or max_time), with progress lines
-    and checkpoints. False if the run stopped early on purpose (--stop-after, tests)."""
+def _paraview(args, out, brk, info):
+    """The ParaView series, <out>/paraview, a frame every args.vtk_interval s of simulated time
+    (None: 20 frames over max_time; 0: none); the anvil drawn as a square around the bed."""
+    interval = getattr(args, "vtk_interval", None)
+    interval = args.max_time / paraview.DEFAULT_FRAMES if interval is None else interval
+    reach = np.max(np.abs(info["centers"][:, :2])) + args.size / 2.0
+    return paraview.series(out / "paraview", brk, interval, resume=getattr(args, "resume", False),
+                           wall_patch=((0.0, 0.0, 0.0), paraview.WALL_MARGIN * reach))
+
+
+def _impact(brk, info, loop, args, out, start, say, frames):
+    """Run until the ball has turned plus TAIL of unloading (or max_time), with progress lines,
+    ParaView frames and checkpoints. False if the run stopped early on purpose (--stop-after,
+    tests)."""
     ball = O.bodies[info["ball"]]
     v0 = info["speed"]
     every = getattr(args, "checkpoint_every", 60.0)
@@ -115,6 +110,7 @@ def _impact(brk, info, loop, args, out, start, say):
         if loop["touched"] is None and any(O.interactions.withBody(info["ball"])):
             loop["touched"] = O.time
             scenes.hold_release(info)
+        frames()                                  # a frame if one is due (before the checkpoint)
         vz = ball.state.vel[2]
         if loop["touched"] is not None and loop["turned"] is None and vz >= 0.0:
             loop["turned"] = O.time            # deepest penetration: loading is over
@@ -128,7 +124,7 @@ def _impact(brk, info, loop, args, out, start, say):
             return True
         now = time.time()
         if every >= 0 and now - last_checkpoint >= every:
-            _checkpoint(out / "checkpoint.yade.gz", info, loop)   # --resume 1 goes on from here
+            _checkpoint(out / "checkpoint.yade.gz", info, loop, args)  # --resume 1 goes on here
             last_checkpoint = now
         if stop_after and O.time >= stop_after:
             return False                          # (tests) as if the run had died here
@@ -150,10 +146,14 @@ def run(args, quiet=False):
     start = time.time()
     say = (lambda m: None) if quiet else progress
     brk, info, loop = _start(args, out, energy, say)
-    if not _impact(brk, info, loop, args, out, start, say):
+    frames = _paraview(args, out, brk, info)
+    if not _impact(brk, info, loop, args, out, start, say, frames):
         return brk, None
     brk.finish()
+    frames.close()                                # the last frame, with the events closed
     summary = _report(brk, info, loop, args, out, energy, time.time() - start)
+    mark_finished(out, args)                      # --resume 1 now says so and does nothing
+    (out / "checkpoint.yade.gz").unlink(missing_ok=True)    # a mid-run state, of no more use
     say(f"done in {summary['runtime_s']:.1f} s: {summary['breakage_events']} breakages, broken "
         f"mass {1e3 * summary['broken_mass']:.3f} g ({100 * summary['broken_mass_fraction']:.1f} "
         f"%), capture radius {1e3 * summary['capture_radius']:.1f} mm; outputs in {out}")
@@ -161,7 +161,7 @@ def run(args, quiet=False):
 
 
 def _report(brk, info, loop, args, out, energy, runtime):
-    """summary.json, the size distribution (CSV and plot), the top view and the VTK file."""
+    """summary.json, the size distribution (CSV and plot) and the top view."""
     initial_mass = loop["initial_mass"]
     sieves = np.geomspace(1e-5, 2 * args.size, 80)
     sd = brk.size_distribution(sieves)
@@ -186,7 +186,6 @@ def _report(brk, info, loop, args, out, energy, runtime):
         w = csv.writer(f)
         w.writerow(["size_m", "passing_percent"])
         w.writerows(zip(sd.sizes, sd.passing_percent))
-    write_vtk(out / "bodies.vtk", brk)
     _plots(out, sd, info, fates, summary)
     return summary
 

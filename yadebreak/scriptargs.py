@@ -1,38 +1,342 @@
 """Parameters of scripts: `--name value` on the command line, or a yade-batch table row.
 
-    args = script_params(dict(material="copper_ore", size=5.5e-3, out="out/x"), __doc__)
+Each option is declared once, with its type, accepted range, unit, default and help:
+
+    args = script_params([
+        number("size", 5.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1),
+        integer("rings", 3, "hexagonal rings around the central particle", lo=0),
+        text("out", "out/x", "output folder"),
+    ], __doc__)
 
 Under yade-batch (YADE_BATCH set), yade.utils.readParamsFromTable supplies the values; otherwise
-argparse reads sys.argv. Types follow the defaults. Never imports yade unless yade-batch runs it.
+argparse reads sys.argv. Either way every value is checked against its declaration before anything
+runs: a bad value stops with one line on stderr naming the option, the value, the accepted range
+and the unit (`[yadebreak] error: --energy = -1: must be > 0 (J)`), exit code 2, as argparse does;
+`--debug 1` shows the traceback instead. Units: plain numbers are SI (m, s, J, J/kg, m/s); the
+option's own unit may follow the number (`--size 5.5mm`, `--energy 3.05J`, `--energies
+100J/kg,200J/kg`), another one is refused. Never imports yade unless yade-batch runs it.
 """
 import argparse
+import json
+import math
 import os
+import re
 import sys
+from dataclasses import dataclass
+from decimal import Decimal
+from pathlib import Path
+
+#: unit of an option -> the units accepted after a number, with their factor to that unit
+UNITS = {
+    "m": {"m": "1", "cm": "1e-2", "mm": "1e-3", "um": "1e-6"},
+    "s": {"s": "1", "ms": "1e-3"},
+    "J": {"J": "1"},
+    "J/kg": {"J/kg": "1"},
+    "m/s": {"m/s": "1"},
+    "%": {"%": "1"},
+    "-": {},
+}
+_NUMBER_THEN_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)\s*$")
+_TRUE, _FALSE = ("1", "true", "yes", "on"), ("0", "false", "no", "off")
+_DEBUG = False                  # --debug 1: tracebacks instead of one-line errors
 
 
-def script_params(defaults, description=None, argv=None):
+class ParamError(ValueError):
+    """A bad value of a script's option; the message names the option, the value, the accepted
+    range and the unit."""
+
+
+@dataclass(frozen=True)
+class Param:
+    """One option of a script; build it with number, integer, numbers, choice, flag or text."""
+
+    name: str
+    default: object
+    kind: str                  # "number", "integer", "numbers", "choice", "flag" or "text"
+    unit: str = "-"            # a key of UNITS ("-": no unit)
+    help: str = ""
+    lo: float = -math.inf
+    hi: float = math.inf
+    lo_open: bool = False
+    hi_open: bool = False
+    words: tuple = ()          # choice: the accepted words; integer: words accepted besides numbers
+
+    @property
+    def flag(self):
+        return "--" + self.name.replace("_", "-")
+
+    @property
+    def numeric(self):
+        return self.kind in ("number", "integer", "numbers")
+
+    @property
+    def accepted(self):
+        """The accepted values, as the error line and --help write them."""
+        if self.kind == "flag":
+            return "0 or 1"
+        if self.kind == "choice":
+            return " or ".join(repr(w) for w in self.words)
+        if self.kind == "text":
+            return "a text"
+        if self.lo == -math.inf and self.hi == math.inf:
+            interval = "any number"
+        elif self.hi == math.inf:
+            interval = f"{'>' if self.lo_open else '>='} {self.lo:g}"
+        elif self.lo == -math.inf:
+            interval = f"{'<' if self.hi_open else '<='} {self.hi:g}"
+        else:
+            interval = (f"in {'(' if self.lo_open else '['}{self.lo:g}, {self.hi:g}"
+                        f"{')' if self.hi_open else ']'}")
+        if self.kind == "integer":
+            interval = "an integer" + ("" if interval == "any number" else f" {interval}")
+            if self.words:
+                interval += ", " + " or ".join(repr(w) for w in self.words)
+        elif self.kind == "numbers":
+            interval = f"distinct numbers separated by commas, each {interval}"
+        return interval
+
+    @property
+    def unit_text(self):
+        return "no unit" if self.unit == "-" else self.unit
+
+    @property
+    def help_line(self):
+        """--help's line, one convention for every script: what it is; accepted values and unit
+        (and the units that may follow a number); default."""
+        parts = [self.help] if self.help else []
+        if self.numeric:
+            accepted = f"{self.accepted} ({self.unit_text})"
+            if self.kind != "integer" and UNITS.get(self.unit):
+                accepted += ", a unit may follow the number: " + ", ".join(UNITS[self.unit])
+            parts.append(accepted)
+        elif self.kind in ("flag", "choice"):
+            parts.append(self.accepted)
+        default = int(bool(self.default)) if self.kind == "flag" else self.default
+        unit = f" {self.unit}" if self.numeric and self.unit != "-" else ""
+        parts.append(f"default {default}{unit}")
+        return "; ".join(parts).replace("%", "%%")       # argparse %-formats help strings
+
+    def _error(self, value, why=""):
+        unit = f" ({self.unit_text})" if self.numeric else ""
+        return ParamError(f"{self.flag} = {value}: must be {self.accepted}{unit}{why}")
+
+    def _in_range(self, v):
+        return (math.isfinite(v) and (v > self.lo if self.lo_open else v >= self.lo)
+                and (v < self.hi if self.hi_open else v <= self.hi))
+
+    def _number(self, text, shown):
+        """A float from `text`: a plain number (SI, parsed as float() always has), or a number
+        followed by one of the option's units (scaled exactly: 5.5mm is 5.5e-3)."""
+        try:
+            return float(text)
+        except ValueError:
+            pass
+        match = _NUMBER_THEN_UNIT.match(text)
+        if not match:
+            raise self._error(shown, f"; {text.strip()!r} is not a number")
+        number, unit = match.groups()
+        factors = UNITS[self.unit]
+        if unit not in factors:
+            known = any(unit in table for table in UNITS.values())
+            own = ", ".join(factors) if factors else "none"
+            raise self._error(shown, f"; {'the unit ' if known else ''}{unit!r} is not accepted "
+                                     f"here (units accepted: {own})")
+        if factors[unit] == "1":
+            return float(number)
+        return float(Decimal(number) * Decimal(factors[unit]))
+
+    def convert(self, value):
+        """The checked value of this option from a command-line text or a yade-batch table value;
+        raises ParamError."""
+        shown = value
+        if value is None and self.default is None:     # a default of None: "not given"
+            return None
+        if self.kind == "text":
+            return str(value)
+        if self.kind == "flag":
+            if isinstance(value, bool):
+                return value
+            word = str(value).strip().lower()
+            if word in _TRUE or word in _FALSE:
+                return word in _TRUE
+            raise self._error(shown)
+        if self.kind == "choice":
+            if value in self.words:
+                return value
+            raise self._error(shown)
+        if self.kind == "numbers":
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                value = str(value)
+            if not isinstance(value, str):
+                raise self._error(shown)
+            texts, numbers = [], []
+            for token in value.split(","):
+                x = self._number(token.strip(), shown)
+                if not self._in_range(x):
+                    raise self._error(shown)
+                # kept as text (the scripts read float() of each, as always), without its unit
+                match = _NUMBER_THEN_UNIT.match(token)
+                if match is None or match.group(2) not in UNITS[self.unit]:
+                    texts.append(token.strip())
+                elif UNITS[self.unit][match.group(2)] == "1":
+                    texts.append(match.group(1))
+                else:
+                    texts.append(repr(x))
+                numbers.append(x)
+            if len(set(numbers)) != len(numbers):
+                raise self._error(shown)
+            return ",".join(texts)
+        if self.kind == "integer":
+            if isinstance(value, str):
+                word = value.strip()
+                if word in self.words:
+                    return word
+                try:
+                    value = int(word)
+                except ValueError:
+                    raise self._error(shown) from None
+            if isinstance(value, bool) or not isinstance(value, int) or not self._in_range(value):
+                raise self._error(shown)
+            return value
+        # number
+        plain = isinstance(value, str) and _is_float(value)
+        if isinstance(value, str):
+            value = self._number(value, shown)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not self._in_range(value):
+            hint = ""
+            if plain and self.unit == "m" and value > self.hi:
+                hint = f"; plain numbers are metres: {shown.strip()}mm for millimetres"
+            raise self._error(shown, hint)
+        return value
+
+
+def _is_float(text):
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def number(name, default, unit, help, lo=-math.inf, hi=math.inf, lo_open=False, hi_open=False):
+    """A real number in `unit` (a key of UNITS), in [lo, hi] (open ends as asked)."""
+    return Param(name, default, "number", unit, help, lo, hi, lo_open, hi_open)
+
+
+def integer(name, default, help, lo=-math.inf, hi=math.inf, words=(), unit="-"):
+    """An integer in [lo, hi], or one of `words`; `unit` names what it counts (no suffix)."""
+    return Param(name, default, "integer", unit, help, lo, hi, words=tuple(words))
+
+
+def numbers(name, default, unit, help, lo=-math.inf, lo_open=False):
+    """A comma-separated list of distinct numbers (kept as text: "100,200,400"), each > or >= lo."""
+    return Param(name, default, "numbers", unit, help, lo, lo_open=lo_open)
+
+
+def choice(name, default, words, help):
+    return Param(name, default, "choice", help=help, words=tuple(words))
+
+
+def flag(name, default, help):
+    """0 or 1 (also true/false, yes/no, on/off); the option alone means 1."""
+    return Param(name, default, "flag", help=help)
+
+
+def text(name, default, help):
+    return Param(name, default, "text", help=help)
+
+
+DEBUG = flag("debug", False, "show the traceback of an error instead of its one line")
+
+
+def _from_defaults(defaults):
+    """Params from a {name: default} dict (types follow the defaults, no range)."""
+    kinds = {bool: "flag", int: "integer", float: "number"}
+    return [Param(k, v, kinds.get(type(v), "text")) for k, v in defaults.items()]
+
+
+def fail(message):
+    """One line on stderr and exit code 2, as argparse does for a user's mistake."""
+    print(f"[yadebreak] error: {message}", file=sys.stderr, flush=True)
+    raise SystemExit(2)
+
+
+class ScriptParser(argparse.ArgumentParser):
+    """argparse with one-line errors (`[yadebreak] error: ...`, exit 2) and help that keeps the
+    description's lines."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", argparse.RawDescriptionHelpFormatter)
+        super().__init__(*args, **kwargs)
+
+    def error(self, message):
+        fail(f"{message} ({self.prog} --help lists the options)")
+
+
+def add_params(parser, params):
+    """Add `params` to an argparse parser (values read as text; check them with read_params)."""
+    for p in params:
+        if p.kind == "flag":            # `--resume` alone is `--resume 1`
+            parser.add_argument(p.flag, dest=p.name, default=p.default, help=p.help_line,
+                                metavar="0|1", nargs="?", const=True)
+        else:
+            parser.add_argument(p.flag, dest=p.name, default=p.default, help=p.help_line)
+
+
+def read_params(namespace, params):
+    """Check and convert every value of `namespace` declared in `params` (in place); a bad one
+    ends the program with its one line (exit 2), or raises it with --debug 1."""
+    global _DEBUG
+    try:
+        _DEBUG = DEBUG.convert(getattr(namespace, "debug", False))
+        for p in params:
+            setattr(namespace, p.name, p.convert(getattr(namespace, p.name)))
+    except ParamError as exc:
+        if _DEBUG:
+            raise
+        fail(str(exc))
+    return namespace
+
+
+def join_negative_values(argv, params):
+    """`--size -5e-3` as `--size=-5e-3`: argparse would take '-5e-3' for an option and say only
+    "expected one argument", not what is wrong with the value."""
+    flags = {p.flag for p in params}
+    out, k = [], 0
+    while k < len(argv):
+        a = argv[k]
+        if a in flags and k + 1 < len(argv) and re.match(r"^-[\d.]", argv[k + 1]):
+            out.append(f"{a}={argv[k + 1]}")
+            k += 2
+        else:
+            out.append(a)
+            k += 1
+    return out
+
+
+def script_params(params, description=None, argv=None):
+    """The checked values of a script's options (an argparse.Namespace). `params`: a list of
+    Param (or a {name: default} dict, types following the defaults). Adds --debug."""
+    if isinstance(params, dict):
+        params = _from_defaults(params)
+    params = [p for p in params if p.name != "debug"] + [DEBUG]
     if os.environ.get("YADE_BATCH"):
         from yade import O, utils
+        defaults = {p.name: p.default for p in params}
         utils.readParamsFromTable(noTableOk=True, **defaults)
         from yade.params import table      # exists once the row has been read
-        values = {k: getattr(table, k) for k in defaults}
+        values = argparse.Namespace(**{k: getattr(table, k) for k in defaults})
+        read_params(values, params)
         description = O.tags["description"] if "description" in O.tags.keys() else None
-        if "out" in defaults and values["out"] == defaults["out"] and description:
-            values["out"] = str(os.path.join(os.path.dirname(defaults["out"]) or ".", "sweep",
-                                             description))
-        return argparse.Namespace(**values)
-    parser = argparse.ArgumentParser(description=description,
-                                     formatter_class=argparse.ArgumentDefaultsHelpFormatter)
-    for name, value in defaults.items():
-        flag = "--" + name.replace("_", "-")
-        if isinstance(value, bool):
-            parser.add_argument(flag, dest=name, type=lambda s: s.lower() in ("1", "true", "yes"),
-                                default=value, metavar="0|1")
-        else:
-            parser.add_argument(flag, dest=name, type=type(value) if value is not None else str,
-                                default=value)
+        if "out" in defaults and values.out == defaults["out"] and description:
+            values.out = str(os.path.join(os.path.dirname(defaults["out"]) or ".", "sweep",
+                                          description))
+        return values
+    parser = ScriptParser(description=description)
+    add_params(parser, params)
     args = sys.argv[1:] if argv is None else argv
-    return parser.parse_args(args)
+    return read_params(parser.parse_args(join_negative_values(list(args), params)), params)
 
 
 class ScriptError(ValueError):
@@ -44,9 +348,14 @@ class StopRequested(Exception):
     """--stop-after: the script ends here, as if killed (tests of --resume)."""
 
 
+class RunFinished(Exception):
+    """--resume of a run that had finished: nothing to do; the script says so and ends (exit 0)."""
+
+
 def run_script(main, *args):
     """Run a script's main(*args): a user's mistake (a bad material file, option or resume)
-    becomes one line on stderr and exit code 2, as argparse does; --stop-after ends with 0.
+    becomes one line on stderr and exit code 2, as argparse does (--debug 1: the traceback);
+    --stop-after ends with 0; resuming a finished run says so and returns None.
     The one place where scripts turn exceptions into exit codes."""
     from .coupling.config import AttachError
     from .materials import MaterialError
@@ -54,12 +363,18 @@ def run_script(main, *args):
         return main(*args)
     except StopRequested:
         raise SystemExit(0) from None
+    except RunFinished as exc:
+        progress(str(exc))
+        return None
     except MaterialError as exc:
+        if _DEBUG:
+            raise
         message = f"{exc.source}: " + "; ".join(exc.problems)
     except (ScriptError, AttachError, FileNotFoundError) as exc:
+        if _DEBUG:
+            raise
         message = str(exc)
-    print(f"[yadebreak] error: {message}", file=sys.stderr, flush=True)
-    raise SystemExit(2)
+    fail(message)
 
 
 def progress(message):
@@ -68,10 +383,12 @@ def progress(message):
 
 
 def resume_arguments(args):
-    """The arguments that decide a run's results (not --resume, --stop-after or --out): what a
-    resumed run must share with the one it continues."""
+    """The arguments that decide a run's results (not --resume, --stop-after, --out,
+    --checkpoint-every, --vtk-interval or --debug): what a resumed run must share with the one it
+    continues."""
     return {k: v for k, v in sorted(vars(args).items())
-            if k not in ("resume", "out", "stop_after")}
+            if k not in ("resume", "out", "stop_after", "checkpoint_every", "vtk_interval",
+                         "debug")}
 
 
 def check_resume_arguments(saved, args, path):
@@ -82,6 +399,29 @@ def check_resume_arguments(saved, args, path):
         changed = sorted(k for k in set(saved) | set(now) if saved.get(k) != now.get(k))
         raise ScriptError(f"--resume: {path} was written with other values of {changed}; run "
                           "again without --resume or with the same values")
+
+
+FINISHED = "finished.json"
+
+
+def mark_started(out):
+    """A new run (not --resume) in `out`: it is no longer a finished one."""
+    (Path(out) / FINISHED).unlink(missing_ok=True)
+
+
+def mark_finished(out, args):
+    """The run in `out` wrote all its outputs: <out>/finished.json keeps its arguments."""
+    (Path(out) / FINISHED).write_text(json.dumps({"arguments": resume_arguments(args)}))
+
+
+def check_not_finished(out, args):
+    """--resume: if the run in `out` finished, refuse other arguments (naming them), then raise
+    RunFinished: nothing is run again and no output is rewritten."""
+    path = Path(out) / FINISHED
+    if path.exists():
+        check_resume_arguments(json.loads(path.read_text())["arguments"], args, path)
+        raise RunFinished(f"the run in {out} had finished: nothing to resume, its outputs are "
+                          "kept (run again without --resume to redo it)")
 
 
 def stop_if_asked(args, units_done):
@@ -99,15 +439,20 @@ class PartialResults:
         for k, energy in partial.todo(energies):     # the units not done yet
             partial.add(energy, compute(k, energy))  # stops here with --stop-after
         results = partial.ordered(energies)
+        ...                                          # the outputs
+        partial.finish()                             # a later --resume 1 has nothing to do
     """
 
     def __init__(self, out, args):
-        import json
-        from pathlib import Path
-        self.path = Path(out) / "partial.json"
+        self.out = Path(out)
+        self.path = self.out / "partial.json"
         self.args = args
         self.done = {}
-        if getattr(args, "resume", False) and self.path.exists():
+        if not getattr(args, "resume", False):
+            mark_started(out)
+            return
+        check_not_finished(out, args)
+        if self.path.exists():
             data = json.loads(self.path.read_text())
             check_resume_arguments(data["arguments"], args, self.path)
             self.done = data["done"]
@@ -122,10 +467,12 @@ class PartialResults:
         return [self.done[str(key)] for key in keys]
 
     def add(self, key, result):
-        import json
-        import os
         self.done[str(key)] = result
         tmp = self.path.with_suffix(".tmp")
         tmp.write_text(json.dumps({"arguments": resume_arguments(self.args), "done": self.done}))
         os.replace(tmp, self.path)
         stop_if_asked(self.args, len(self.done))
+
+    def finish(self):
+        """Every output is written: a later --resume 1 says so and does nothing."""
+        mark_finished(self.out, self.args)

@@ -1,0 +1,142 @@
+"""Script options (issue 16): every numeric option is checked before the run (one line naming the
+option, the value, the range and the unit; exit code 2; no traceback), units may be written
+(`--size 5.5mm`), --help shows units and defaults, and the bed's --resume refuses other arguments
+and says when the run had finished. The scripts run as users run them."""
+import json
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from yadebreak.scriptargs import ParamError, numbers, number, script_params
+
+ROOT = Path(__file__).resolve().parent.parent
+PYTHON = "/usr/bin/python3"
+
+
+def _yade(script, *arguments):
+    return subprocess.run(["yade", "-n", "-x", str(ROOT / "scripts" / f"{script}.py"), *arguments],
+                          capture_output=True, text=True, timeout=300, cwd=ROOT)
+
+
+def _one_error_line(proc):
+    """The single `[yadebreak] error:` line of a failed run (YADE's own banner lines aside)."""
+    assert proc.returncode == 2, proc.stdout[-1500:] + proc.stderr[-1500:]
+    assert "Traceback" not in proc.stdout + proc.stderr
+    lines = [line for line in (proc.stdout + proc.stderr).splitlines() if "error" in line.lower()]
+    assert len(lines) == 1 and lines[0].startswith("[yadebreak] error: "), lines
+    return lines[0]
+
+
+# (script, arguments, the error line's "option = value", the range, the unit)
+BAD_VALUES = [
+    ("bed_impact", ["--energy", "-1"], "--energy = -1", "> 0", "(J)"),
+    ("bed_impact", ["--size=-5e-3"], "--size = -5e-3", "in (0, 1]", "(m)"),
+    ("bed_impact", ["--rings=-1"], "--rings = -1", "an integer >= 0", "(no unit)"),
+    ("bed_impact", ["--layers", "0"], "--layers = 0", "an integer >= 1", "(no unit)"),
+    ("bed_impact", ["--energy", "2J/kg"], "--energy = 2J/kg", "> 0", "(J)"),
+    ("single_impact", ["--particles", "0"], "--particles = 0", "an integer >= 1", "(no unit)"),
+    ("single_impact", ["--energies=-100"], "--energies = -100",
+     "distinct numbers separated by commas, each > 0", "(J/kg)"),
+    ("drop_weight", ["--max-time", "0"], "--max-time = 0", "> 0", "(s)"),
+    ("repeated_impact", ["--energy", "3J"], "--energy = 3J", "> 0", "(J/kg)"),
+]
+
+
+@pytest.mark.yade
+@pytest.mark.parametrize("script, arguments, named, accepted, unit", BAD_VALUES)
+def test_bad_value_stops_before_the_run_with_one_line(tmp_path, script, arguments, named,
+                                                      accepted, unit):
+    out = tmp_path / "out"
+    line = _one_error_line(_yade(script, *arguments, "--out", str(out)))
+    assert f"{named}: must be {accepted}" in line and unit in line, line
+    assert not out.exists()                          # stopped before anything was built
+
+
+def test_families_command_checks_t10(tmp_path):
+    command = [PYTHON, "-m", "yadebreak", "families", "--t10", "500", "--out",
+               str(tmp_path / "f.png")]
+    proc = subprocess.run(command, capture_output=True, text=True, timeout=120, cwd=ROOT)
+    assert _one_error_line(proc) == "[yadebreak] error: --t10 = 500: must be in (0, 100] (%)"
+    assert not (tmp_path / "f.png").exists()
+    proc = subprocess.run(command + ["--debug", "1"], capture_output=True, text=True, timeout=120,
+                          cwd=ROOT)
+    assert proc.returncode != 0 and "Traceback" in proc.stderr       # --debug shows it
+
+
+SIZE = number("size", 5.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1)
+ENERGY = number("energy", 3.05, "J", "impact energy", lo=0, lo_open=True)
+ENERGIES = numbers("energies", "100,200,400", "J/kg", "specific energies", lo=0, lo_open=True)
+
+
+@pytest.mark.parametrize("size", ["5.5mm", "5.5e-3", "0.0055", "5.5e-3m", "0.55cm", "5.5 mm"])
+def test_a_size_means_the_same_with_or_without_its_unit(size):
+    assert script_params([SIZE], argv=["--size", size]).size == 5.5e-3
+    assert script_params([SIZE], argv=[]).size == 5.5e-3
+    assert script_params([SIZE], argv=["--size", "5.3mm"]).size == 5.3e-3   # not 5.3 * 1e-3
+
+
+def test_energies_take_their_own_unit_only():
+    args = script_params([ENERGY, ENERGIES], argv=["--energy", "3.05J",
+                                                   "--energies", "100J/kg, 200 J/kg,4e2"])
+    assert args.energy == 3.05 and args.energies == "100,200,4e2"   # as plain J/kg, as always
+    with pytest.raises(ParamError, match=r"--energy = 3.05J/kg: must be > 0 \(J\)"):
+        ENERGY.convert("3.05J/kg")
+    with pytest.raises(ParamError, match=r"--energies = 100J: .* \(J/kg\)"):
+        ENERGIES.convert("100J")
+    with pytest.raises(ParamError, match="distinct"):
+        ENERGIES.convert("100,100")
+    with pytest.raises(ParamError, match=r"--size = 5.5: must be in \(0, 1\] \(m\); plain numbers"):
+        SIZE.convert("5.5")
+
+
+def test_yade_batch_values_are_checked_the_same_way():
+    """readParamsFromTable gives numbers, or strings for quoted cells: both go through convert."""
+    assert SIZE.convert(0.0055) == 5.5e-3 and SIZE.convert("5.5mm") == 5.5e-3
+    assert ENERGIES.convert(150) == "150"
+    for bad in (-1, float("nan"), True, "abc"):
+        with pytest.raises(ParamError, match="--energy = "):
+            ENERGY.convert(bad)
+
+
+@pytest.mark.yade
+@pytest.mark.parametrize("script, shown", [
+    ("bed_impact", ["--size SIZE", "(m), a unit may follow the number: m, cm, mm, um",
+                    "default 0.0055 m", "> 0 (J)", "default 3.05 J", "default 3 "]),
+    ("single_impact", ["each > 0 (J/kg)", "default 100,200,400 J/kg", "default 250"]),
+    ("drop_weight", ["default 0.003 s", "default 150,600 J/kg"]),
+    ("repeated_impact", ["> 0 (J/kg)", "default 94.7 J/kg", "default 0.0375 m"]),
+])
+def test_help_shows_units_and_defaults(script, shown):
+    proc = _yade(script, "--help")
+    assert proc.returncode == 0, proc.stderr[-1500:]
+    text = " ".join(proc.stdout.split())          # argparse wraps lines
+    for s in shown:
+        assert s in text, s
+
+
+def _bed(out, *extra):
+    return _yade("bed_impact", "--rings", "1", "--energy", "0.5", "--out", str(out), *extra)
+
+
+@pytest.mark.yade
+def test_bed_resume_refuses_other_arguments_and_says_when_finished(tmp_path):
+    cut = _bed(tmp_path, "--checkpoint-every", "0", "--stop-after", "1e-4")   # dies at 0.1 ms
+    assert cut.returncode == 0, cut.stderr[-1500:]
+    assert (tmp_path / "checkpoint.yade.gz").exists() and not (tmp_path / "summary.json").exists()
+
+    line = _one_error_line(_bed(tmp_path, "--resume", "1", "--energy", "0.6"))
+    assert "other values of ['energy']" in line, line
+
+    resumed = _bed(tmp_path, "--resume", "1", "--size", "5.5mm")      # the same arguments
+    assert resumed.returncode == 0, resumed.stderr[-1500:]
+    assert "resumed from" in resumed.stdout
+    summary = (tmp_path / "summary.json").read_text()
+    assert not (tmp_path / "checkpoint.yade.gz").exists()             # finished: no checkpoint
+
+    again = _bed(tmp_path, "--resume", "1")
+    assert again.returncode == 0 and "had finished: nothing to resume" in again.stdout
+    assert (tmp_path / "summary.json").read_text() == summary         # not rewritten
+    line = _one_error_line(_bed(tmp_path, "--resume", "1", "--energy", "0.6", "--rings", "2"))
+    assert "other values of ['energy', 'rings']" in line, line
+    assert json.loads(summary)["energy"] == 0.5
