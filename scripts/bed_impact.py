@@ -15,19 +15,19 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.scriptargs import choice, flag, integer, number, script_params, text  # noqa: E402
+from yadebreak.scriptargs import (choice, flag, integer, material_option, number,  # noqa: E402
+                                  script_params, size_option, text, time_step_option)
 
 args = script_params([
-    text("material", "copper_ore", "material of the bed: a name of the library or a .toml file"),
-    number("size", 5.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1),
+    material_option("the bed"),
+    size_option(5.5e-3),
     integer("rings", 3, "hexagonal rings around the central particle", lo=0),
     integer("layers", 1, "layers of particles (more than one: held by a holder until the touch)",
             lo=1),
     number("energy", 3.05, "J", "impact energy of the ball (not per kg)", lo=0, lo_open=True),
     number("speed", 0.0, "m/s", "the ball's speed instead of --energy (0: from --energy)", lo=0),
     integer("seed", 1, "random seed", lo=0),
-    number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest sphere's "
-           "Rayleigh time", lo=0, lo_open=True, hi=1),
+    time_step_option(),
     number("dmin", 0.0, "m", "fragments whose progeny would be finer never break "
            "(0: particle size / 20)", lo=0),
     number("global_damping", 0.0, "-", "Newton damping of fresh fragments (0: none)", lo=0, hi=1,

@@ -14,20 +14,19 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 
 
 from yadebreak import load_material, reports  # noqa: E402
-from yadebreak.scriptargs import (PartialResults, flag, integer, number, numbers,  # noqa: E402
-                                  progress, run_script, script_params, text)
+from yadebreak.scriptargs import (PartialResults, flag, integer, material_option,  # noqa: E402
+                                  number, numbers, progress, run_script, script_params,
+                                  size_option, text, time_step_option)
 
 args = script_params([
-    text("material", "copper_ore", "material of the particles: a name of the library or a .toml "
-         "file"),
-    number("size", 5.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1),
+    material_option(),
+    size_option(5.5e-3),
     integer("particles", 60, "particles tested at each energy", lo=1),
     integer("seed", 1, "random seed of the first energy (the next ones: +1, +2, ...)", lo=0),
     numbers("energies", "150,600", "J/kg", "specific energies of the striker's fall per particle "
             "mass", lo=0, lo_open=True),
     number("striker_mass_ratio", 50.0, "-", "striker mass over particle mass", lo=0, lo_open=True),
-    number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest sphere's "
-           "Rayleigh time", lo=0, lo_open=True, hi=1),
+    time_step_option(),
     number("max_time", 0.003, "s", "simulated time per energy at the most", lo=0, lo_open=True),
     text("out", "out/drop_weight", "output folder"),
     flag("resume", False, "continue the run in --out, keeping the energies it finished"),

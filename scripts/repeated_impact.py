@@ -23,13 +23,13 @@ import numpy as np  # noqa: E402
 from yadebreak import load_material, model  # noqa: E402
 from yadebreak.scriptargs import (ScriptError, check_not_finished,  # noqa: E402
                                   check_resume_arguments, flag, integer, mark_finished,
-                                  mark_started, number, progress, resume_arguments, run_script,
-                                  script_params, stop_if_asked, text)
+                                  mark_started, material_option, number, progress,
+                                  resume_arguments, run_script, script_params, size_option,
+                                  stop_if_asked, text, time_step_option)
 
 args = script_params([
-    text("material", "copper_ore", "material of the particles: a name of the library or a .toml "
-         "file"),
-    number("size", 37.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1),
+    material_option(),
+    size_option(37.5e-3),
     integer("particles", 100, "particles", lo=1),
     integer("impacts", 20, "impacts of each particle", lo=1),
     number("energy", 94.7, "J/kg", "specific impact energy Ek/mp = v^2/2 of every impact", lo=0,
@@ -38,8 +38,7 @@ args = script_params([
            "material's)", lo=0),
     integer("seed", 1, "random seed", lo=0),
     text("target", "steel", "the plate: steel, rubber or a material"),
-    number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest sphere's "
-           "Rayleigh time", lo=0, lo_open=True, hi=1),
+    time_step_option(),
     text("out", "out/repeated_impact", "output folder"),
     flag("resume", False, "continue the run in --out from the checkpoint after its last impact"),
     integer("stop_after", 0, "(tests) end as if killed after this many impacts (0: never)", lo=0,

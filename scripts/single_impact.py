@@ -19,21 +19,20 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 import numpy as np  # noqa: E402
 
 from yadebreak import load_material, reports  # noqa: E402
-from yadebreak.scriptargs import (PartialResults, flag, integer, number, numbers,  # noqa: E402
-                                  progress, run_script, script_params, text)
+from yadebreak.scriptargs import (PartialResults, flag, integer, material_option,  # noqa: E402
+                                  numbers, progress, run_script, script_params, size_option,
+                                  text, time_step_option)
 
 args = script_params([
-    text("material", "copper_ore", "material of the particles: a name of the library or a .toml "
-         "file"),
-    number("size", 5.5e-3, "m", "particle size", lo=0, lo_open=True, hi=1),
+    material_option(),
+    size_option(5.5e-3),
     integer("particles", 250, "particles fired at each energy", lo=1),
     integer("seed", 1, "random seed of the first energy (the next ones: +1, +2, ...)", lo=0),
     text("target", "steel", "the plate: steel, rubber or a material"),
     numbers("energies", "100,200,400", "J/kg", "specific impact energies Ek/mp = v^2/2", lo=0,
             lo_open=True),
     flag("replace", True, "replace broken particles by their fragments (0: record events only)"),
-    number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest sphere's "
-           "Rayleigh time", lo=0, lo_open=True, hi=1),
+    time_step_option(),
     text("out", "out/single_impact", "output folder"),
     flag("resume", False, "continue the run in --out, keeping the energies it finished"),
     integer("stop_after", 0, "(tests) end as if killed after this many energies (0: never)", lo=0,

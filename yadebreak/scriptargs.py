@@ -250,6 +250,20 @@ def text(name, default, help):
 DEBUG = flag("debug", False, "show the traceback of an error instead of its one line")
 
 
+# options that the impact scripts share, declared once
+def material_option(of="the particles"):
+    return text("material", "copper_ore", f"material of {of}: a name of the library or a .toml file")
+
+
+def size_option(default):
+    return number("size", default, "m", "particle size", lo=0, lo_open=True, hi=1)
+
+
+def time_step_option():
+    return number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest "
+                  "sphere's Rayleigh time", lo=0, lo_open=True, hi=1)
+
+
 def _from_defaults(defaults):
     """Params from a {name: default} dict (types follow the defaults, no range)."""
     kinds = {bool: "flag", int: "integer", float: "number"}
