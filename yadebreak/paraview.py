@@ -28,7 +28,7 @@ import numpy as np
 from .coupling._yade import O, wrapper
 from .coupling.state import NONE
 
-#: default number of frames over a run's planned simulated time (bed_impact: max_time / 20)
+#: frames over a run's planned simulated time when no interval is given (bed.run: max_time / 20)
 DEFAULT_FRAMES = 20
 #: fracture_energy written for bodies that cannot break (ParaView's ASCII reader takes no inf/nan)
 NO_FRACTURE_ENERGY = -1.0

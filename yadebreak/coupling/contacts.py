@@ -139,9 +139,9 @@ class ContactReader:
 
     def read(self, interactions, bodies, tracked, zeroed, now, interval, asleep=()):
         """One pass over the interactions; contacts that ceased drop out. `zeroed` holds the pairs
-        whose kno varies, `asleep` those of them (as (smaller id, larger id): YADE's id1 may be
-        the larger) that carry no force and are not visited now (their records stay as they
-        were: they do no work); `interval` is the steps since the last read."""
+        whose kno varies, `asleep` those of them that carry no force and are not visited now
+        (their records stay as they were: they do no work), all keyed (smaller id, larger id);
+        `interval` is the steps since the last read."""
         cs, emin = self.cs, self.emin
         inherited = self.inherited
         work_loading, work_to_peak = self.law.loading, self.law.to_peak
@@ -158,6 +158,9 @@ class ContactReader:
             if not (in_a or in_b):
                 continue
             key = (a, b)
+            # zeroed, asleep and inherited pairs are (smaller id, larger id); YADE's id1 may be
+            # the larger
+            pair = key if a < b else (b, a)
             c = contacts.get(key)
             update = True
             if c is None:
@@ -165,11 +168,11 @@ class ContactReader:
                 if c is None:
                     continue
                 contacts[key] = c
-                if inherited and ((a, b) if a < b else (b, a)) in inherited:
+                if inherited and pair in inherited:
                     c.start_here()
             elif c.geom is None:                  # restored from a save: YADE's objects again
                 c.geom, c.phys = i.geom, i.phys
-            elif asleep and ((a, b) if a < b else (b, a)) in asleep:
+            elif asleep and pair in asleep:
                 update = False                    # a slack zeroed pair: no force, no work
             if update:
                 g = c.geom
@@ -178,7 +181,7 @@ class ContactReader:
                 d0 = c.overlap
                 peaked = delta < d0 and c.overlap_before < d0 and c.time_read > c.time_before
                 if delta > d0 or peaked:
-                    hertz = not (zeroed and ((a, b) in zeroed or (b, a) in zeroed))
+                    hertz = not (zeroed and pair in zeroed)
                     if delta > d0:
                         work = work_loading(c, delta, force, hertz, first_touch)
                     else:
