@@ -3,7 +3,8 @@ on a steel anvil; breakage probability, t10 and the progeny size distribution ag
 
     yade -n -x scripts/drop_weight.py --material copper_ore --energies 150,600
 
-An interrupted run continues with --resume 1, keeping the energies it finished (out/partial.json).
+An interrupted run continues with --resume 1, keeping the energies it finished (out/partial.json);
+a run that fails leaves summary.json with the energies it finished and its end_reason.
 """
 import json
 import sys
@@ -15,8 +16,9 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 
 from yadebreak import load_material, reports  # noqa: E402
 from yadebreak.scriptargs import (PartialResults, flag, integer, material_option,  # noqa: E402
-                                  number, numbers, progress, run_script, script_params,
-                                  size_option, text, time_step_option)
+                                  number, numbers, partial_outputs_on_failure, progress,
+                                  run_script, script_params, size_option, text,
+                                  time_step_option)
 
 args = script_params([
     material_option(),
@@ -47,30 +49,47 @@ def main(args):
     start = time.time()
     energies = [float(e) for e in args.energies.split(",")]
     partial = PartialResults(out, args)
-    for k, energy in partial.todo(energies):
-        brk, ids, strikers = scenes.drop_weight_scene(
-            args.material, args.size, energy, args.particles, args.striker_mass_ratio,
-            seed=args.seed + k, time_step_fraction=args.time_step_fraction,
-            event_log=str(out / f"events_{energy:g}.jsonl"))
-        initial_mass = brk.total_mass()
-        # until every striker rebounds (or max_time of simulated time); then open events close
-        while any(O.bodies[s].state.vel[2] < 0 for s in strikers) and O.time < args.max_time:
-            coupling.run_steps(500)
-        brk.finish()
-        result = reports.breakage_result(brk, ids, mat, args.size, energy, steel)
-        result["mass_relative_error"] = abs(brk.total_mass() - initial_mass) / initial_mass
-        partial.add(energy, result)
-        progress(f"{reports.result_line(result)}, {time.time() - start:.1f} s")
 
-    results = partial.ordered(energies)
-    (out / "summary.json").write_text(json.dumps({"material": mat.name, "size": args.size,
-                                                  "results": results,
-                                                  "runtime_s": time.time() - start}, indent=2))
-    reports.plot_breakage(results, mat, args.size, steel, f"{mat.name} drop weight",
-                          out / "drop_weight.png", label="drop weight, simulation")
+    def write(end_reason, end_message):
+        """summary.json and the plot of the energies finished so far."""
+        results = partial.ordered([e for e in energies if str(e) in partial.done])
+        (out / "summary.json").write_text(json.dumps({
+            "material": mat.name, "size": args.size, "results": results,
+            "runtime_s": time.time() - start, "end_reason": end_reason,
+            "end_message": end_message}, indent=2))
+        if results:
+            reports.plot_breakage(results, mat, args.size, steel, f"{mat.name} drop weight",
+                                  out / "drop_weight.png", label="drop weight, simulation")
+
+    with partial_outputs_on_failure(write):
+        for k, energy in partial.todo(energies):
+            brk, result = drop_at(args, mat, steel, k, energy, out)
+            partial.add(energy, result)
+            progress(f"{reports.result_line(result)}, {time.time() - start:.1f} s")
+    limited = [r["specific_energy"] for r in partial.ordered(energies) if r["stopped_at_max_time"]]
+    write("time_limit" if limited else "finished",
+          f"strikers still falling at --max-time at {limited} J/kg" if limited else "")
     partial.finish()
     progress(f"wrote {out / 'summary.json'} and {out / 'drop_weight.png'}")
     return brk
+
+
+def drop_at(args, mat, steel, k, energy, out):
+    """The drop-weight tests at `energy` (J/kg): (controller, the energy's result)."""
+    brk, ids, strikers = scenes.drop_weight_scene(
+        args.material, args.size, energy, args.particles, args.striker_mass_ratio,
+        seed=args.seed + k, time_step_fraction=args.time_step_fraction,
+        event_log=str(out / f"events_{energy:g}.jsonl"))
+    initial_mass = brk.total_mass()
+    # until every striker rebounds (or max_time of simulated time); then open events close
+    while any(O.bodies[s].state.vel[2] < 0 for s in strikers) and O.time < args.max_time:
+        coupling.run_steps(500)
+    stopped = any(O.bodies[s].state.vel[2] < 0 for s in strikers)
+    brk.finish()
+    result = reports.breakage_result(brk, ids, mat, args.size, energy, steel)
+    result["mass_relative_error"] = abs(brk.total_mass() - initial_mass) / initial_mass
+    result["stopped_at_max_time"] = stopped
+    return brk, result
 
 
 brk = run_script(main, args)      # the last scene's controller, at the prompt without -x

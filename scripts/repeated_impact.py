@@ -20,10 +20,11 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 
 import numpy as np  # noqa: E402
 
-from yadebreak import load_material, model  # noqa: E402
+from yadebreak import load_material, model, reports  # noqa: E402
 from yadebreak.scriptargs import (ScriptError, check_not_finished,  # noqa: E402
                                   check_resume_arguments, flag, integer, mark_finished,
-                                  mark_started, material_option, number, progress,
+                                  mark_started, material_option, number,
+                                  partial_outputs_on_failure, progress,
                                   resume_arguments, run_script, script_params, size_option,
                                   stop_if_asked, text, time_step_option)
 
@@ -78,24 +79,35 @@ def main(args):
         home = {i: tuple(O.bodies[i].state.pos) for i in ids}
         alive = list(ids)
         fractions = []
-    for k in range(len(fractions), args.impacts):
-        alive = scenes.impact_again(brk, alive, home, speed)   # broken particles leave the test
-        fractions.append(1 - len(alive) / args.particles)
-        progress(f"impact {k + 1}: {100 * fractions[-1]:.0f} % broken, {time.time() - start:.1f} s")
-        coupling.save_checkpoint(checkpoint, {
-            "ids": ids, "alive": alive, "fractions": fractions, "home": home,
-            "arguments": resume_arguments(args)})
-        stop_if_asked(args, len(fractions))
+    with partial_outputs_on_failure(lambda reason, message: write_outputs(
+            args, mat, share, fractions, brk, out, start, reason, message)):
+        for k in range(len(fractions), args.impacts):
+            alive = scenes.impact_again(brk, alive, home, speed)  # the broken leave the test
+            fractions.append(1 - len(alive) / args.particles)
+            progress(f"impact {k + 1}: {100 * fractions[-1]:.0f} % broken, "
+                     f"{time.time() - start:.1f} s")
+            coupling.save_checkpoint(checkpoint, {
+                "ids": ids, "alive": alive, "fractions": fractions, "home": home,
+                "arguments": resume_arguments(args)})
+            stop_if_asked(args, len(fractions))
+    write_outputs(args, mat, share, fractions, brk, out, start, "finished", "")
+    mark_finished(out, args)              # a later --resume 1 says so and does nothing
+    progress(f"wrote {out / 'summary.json'} and {out / 'repeated_impact.png'}")
+    return brk
 
+
+def write_outputs(args, mat, share, fractions, brk, out, start, end_reason, end_message):
+    """summary.json (with how the run ended) and the plot, for the impacts done."""
     if mat.is_ab_t10:
         model_fractions = model.ab_t10_repeated_broken_fraction(
             share * args.energy, args.size, float(mat.min_energy(args.size)), mat.selection,
-            mat.size_ref, args.impacts)
+            mat.size_ref, len(fractions))
         model_label = "model P(e_cum), e_cum = k (e Ek/mp - e_min) (Eqs. 9.1-9.3)"
     else:
         e50 = float(mat.median_fracture_energy(args.size))
         model_fractions = model.repeated_impact_broken_fraction(share * args.energy, e50, mat.sigma,
-                                                                mat.emax_ratio, mat.gamma, args.impacts)
+                                                                mat.emax_ratio, mat.gamma,
+                                                                len(fractions))
         model_label = f"model (Eqs. 1-6), gamma = {mat.gamma:g}"
     absorbed = [e["specific_energy"] for e in brk.events if e["kind"] == "damage"]
     summary = {"material": mat.name, "model": mat.breakage_model, "size": args.size,
@@ -104,27 +116,29 @@ def main(args):
                "broken_fraction": fractions, "model_broken_fraction": model_fractions.tolist(),
                "mean_absorbed_specific_energy": float(np.mean(absorbed)) if absorbed else None,
                "expected_absorbed_specific_energy": share * args.energy,
-               "runtime_s": time.time() - start}
+               "runtime_s": time.time() - start, "end_reason": end_reason,
+               "end_message": end_message}
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
 
     import matplotlib  # noqa: E402
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: E402
+    from matplotlib.ticker import MaxNLocator  # noqa: E402
 
-    n = np.arange(1, args.impacts + 1)
+    n = np.arange(1, len(fractions) + 1)
     fig, ax = plt.subplots(figsize=(6, 4.5))
     ax.plot(n, 100 * model_fractions, "k-", label=model_label)
     sigma = np.sqrt(model_fractions * (1 - model_fractions) / args.particles)
-    ax.errorbar(n, 100 * np.array(fractions), yerr=300 * sigma, fmt="o", c="C3",
-                label="simulation (3 sigma of the model)")
+    ax.errorbar(n, 100 * np.array(fractions),
+                yerr=reports.bounded_errors(100 * np.array(fractions), 300 * sigma, 0.0, 100.0),
+                fmt="o", c="C3", label="simulation (3 sigma of the model)")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))      # impacts are counted
     ax.set(xlabel="number of impacts", ylabel="broken (%)",
            title=f"{mat.name}, {1e3 * args.size:g} mm at {args.energy:g} J/kg on {args.target}")
     ax.legend()
     fig.tight_layout()
     fig.savefig(out / "repeated_impact.png", dpi=110)
-    mark_finished(out, args)              # a later --resume 1 says so and does nothing
-    progress(f"wrote {out / 'summary.json'} and {out / 'repeated_impact.png'}")
-    return brk
+    plt.close(fig)
 
 
 brk = run_script(main, args)      # the controller, at the prompt without -x

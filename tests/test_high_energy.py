@@ -1,5 +1,7 @@
 """High-energy fidelity (issue 20): the model's t10 at each energy (Eq. 7 with E50b), and impacts
 that go on until the fragments are done, so that successive breakage makes the progeny finer."""
+import json
+
 import numpy as np
 import pytest
 
@@ -122,3 +124,83 @@ def test_opening_slack_pairs_sleep_and_a_returning_pair_pushes_within_the_tolera
         run_steps(1)
     d_push = 2 * r - (O.bodies[b].state.pos[0] - O.bodies[a].state.pos[0])
     assert d_turn <= d_push <= d_turn * 1.05 + 2 * 1.0 * O.dt
+
+
+@pytest.mark.yade
+def test_one_scene_is_the_run_it_always_was(scene, tmp_path):
+    """single_impacts with every particle in one scene gives what impact_scene, run_until_rebound
+    and breakage_result gave (the same seed: the same run), event for event."""
+    from yade import O
+    from yadebreak import coupling, reports, scenes
+    cu, steel, speed = load_material("copper_ore"), load_material("steel"), np.sqrt(2 * 700.0)
+    brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [speed] * 6, seed=4)
+    scenes.run_until_rebound(ids, brk=brk)
+    before = reports.breakage_result(brk, ids, cu, 5.5e-3, 700.0, steel)
+    events = [dict(e) for e in brk.events]
+    coupling.forget()
+    O.reset()
+    tally, _, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, 6, 6, 4,
+                                        event_log=str(tmp_path / "events.jsonl"))
+    assert reports.breakage_result_of(tally, cu, 700.0, steel) == before
+    logged = [json.loads(line) for line in (tmp_path / "events.jsonl").read_text().splitlines()]
+    assert logged == [{"scene": 0, **e} for e in events] and before["broken_fraction"] > 0
+
+
+@pytest.mark.yade
+def test_scenes_of_a_few_fire_every_particle_and_keep_every_event(scene, tmp_path):
+    """Seven particles in scenes of three: three scenes, seven first events, the events of every
+    scene in the log (named by scene), the mass kept, no running scene's log left behind."""
+    from yadebreak import scenes
+    log = tmp_path / "events.jsonl"
+    seen = []
+    tally, steps, _ = scenes.single_impacts("copper_ore", 5.5e-3, np.sqrt(2 * 700.0), 7, 3, 4,
+                                            event_log=str(log),
+                                            on_scene=lambda k, n, t: seen.append((k, n)))
+    assert seen == [(1, 3), (2, 3), (3, 3)]
+    assert tally.particles == 7 and len(tally.first) == 7
+    logged = [json.loads(line) for line in log.read_text().splitlines()]
+    assert {e["scene"] for e in logged} == {0, 1, 2}
+    assert sum(e["kind"] == "breakage" for e in logged) == tally.breakage_events > 0
+    assert tally.mass_relative_error < 1e-12
+    assert not log.with_suffix(".scene.jsonl").exists()
+    assert scenes.scene_seed(4, 0) == 4 and len({scenes.scene_seed(4, k) for k in range(3)}) == 3
+
+
+@pytest.mark.yade
+def test_breakage_probability_does_not_depend_on_the_scene_size(scene):
+    """60 copper ore particles (5.5 mm) at 500 J/kg, where the model breaks about half: in one
+    scene and in scenes of one, the broken fractions are two samples of the same binomial; they
+    differ by less than 3 sigma of a difference, sqrt(2 P (1 - P) / 60) = 0.09 at P = 0.5, and
+    each lies within 3 sigma of the model."""
+    from yadebreak import reports, scenes
+    cu, steel, speed, n = load_material("copper_ore"), load_material("steel"), np.sqrt(1000.0), 60
+    p_model = float(cu.breakage_probability(500.0, 5.5e-3, partner=steel))
+    sigma = np.sqrt(p_model * (1 - p_model) / n)
+    fractions = []
+    for per_scene in (n, 1):
+        tally, _, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, n, per_scene, 9,
+                                            replace=False)
+        fractions.append(reports.breakage_result_of(tally, cu, 500.0, steel)["broken_fraction"])
+    assert 0.25 < p_model < 0.75
+    assert abs(fractions[0] - fractions[1]) < 3 * np.sqrt(2) * sigma
+    assert all(abs(f - p_model) < 3 * sigma for f in fractions), (fractions, p_model)
+
+
+@pytest.mark.yade
+def test_scenes_shared_among_processes_give_the_same_run(scene, tmp_path):
+    """Five scenes of one copper ore particle at 700 J/kg, run here and shared between two YADE
+    processes: the same events in the same order (each scene has its seed), and the same result
+    but for the order of the sums over scenes (1e-9 relative)."""
+    from yadebreak import reports, scenes
+    cu, steel, speed = load_material("copper_ore"), load_material("steel"), np.sqrt(2 * 700.0)
+    results, logs = [], []
+    for jobs in (1, 2):
+        log = tmp_path / f"events_{jobs}.jsonl"
+        tally, steps, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, 5, 1, 4,
+                                                event_log=str(log), jobs=jobs)
+        results.append((reports.breakage_result_of(tally, cu, 700.0, steel), steps,
+                        tally.scenes, tally.mass_relative_error < 1e-12))
+        logs.append(log.read_text())
+    assert logs[0] == logs[1] and '"kind": "breakage"' in logs[0]
+    from regression.cases import differences
+    assert differences(list(results[0]), list(results[1])) == [] and results[0][2] == 5

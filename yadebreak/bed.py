@@ -12,7 +12,7 @@ import numpy as np
 from . import coupling, paraview, scenes
 from .coupling._yade import O
 from .scriptargs import (check_not_finished, check_resume_arguments, mark_finished, mark_started,
-                         progress, resume_arguments)
+                         partial_outputs_on_failure, progress, resume_arguments, time_left)
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
 TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
@@ -81,9 +81,30 @@ def _start(args, out, energy, say):
     mark_started(out)
     brk, info = scenes.bed_impact_scene(args.material, args.size, args.rings, args.layers,
                                         energy, args.seed, **_options(args, out))
+    mass = brk.total_mass()
     say(f"{len(info['particles'])} particles of {args.material} ({1e3 * args.size:g} mm), "
-        f"{args.layers} layer(s); ball at {info['speed']:.3f} m/s ({energy:g} J); dt {O.dt:.3g} s")
-    return brk, info, {"touched": None, "turned": None, "initial_mass": brk.total_mass()}
+        f"{args.layers} layer(s); ball at {info['speed']:.3f} m/s ({energy:g} J, "
+        f"{energy / mass:.0f} J per kg of bed); dt {O.dt:.3g} s")
+    return brk, info, {"touched": None, "turned": None, "initial_mass": mass, "initial_dt": O.dt}
+
+
+def finest_sphere_size():
+    """Diameter (m) of the smallest sphere in the scene (a pass over the bodies: once, at the end)."""
+    from .coupling._yade import wrapper
+    return min((2.0 * b.shape.radius for b in O.bodies
+                if b is not None and isinstance(b.shape, wrapper.Sphere)), default=float("nan"))
+
+
+def why_it_took_longer(summary):
+    """Why a run took more steps than its start promised, or None: the time step fell for finer
+    fragments (a small bed under the same ball takes more energy per kg and breaks finer)."""
+    start_dt, dt = summary.get("initial_dt"), summary["final_dt"]
+    if start_dt is None or not dt < 0.5 * start_dt:
+        return None
+    return (f"the time step fell {start_dt / dt:.0f}-fold, to {dt:.2g} s, for fragments down to "
+            f"{1e3 * summary['finest_sphere_size']:.2f} mm: {summary['energy_per_bed_mass']:.0f} "
+            "J/kg of bed broke them that fine (fewer particles under the same ball take more "
+            "energy each, break finer and need more, shorter steps)")
 
 
 def _paraview(args, out, brk, info):
@@ -98,8 +119,8 @@ def _paraview(args, out, brk, info):
 
 def _impact(brk, info, loop, args, out, start, say, frames):
     """Run until the ball has turned plus TAIL of unloading (or max_time), with progress lines,
-    ParaView frames and checkpoints. False if the run stopped early on purpose (--stop-after,
-    tests)."""
+    ParaView frames and checkpoints. Returns how it ended: "finished", "time_limit" (max_time),
+    or None if it stopped early on purpose (--stop-after, tests)."""
     ball = O.bodies[info["ball"]]
     v0 = info["speed"]
     every = getattr(args, "checkpoint_every", 60.0)
@@ -118,23 +139,22 @@ def _impact(brk, info, loop, args, out, start, say, frames):
         # breakage happens while loading: after the turn, a short unloading, then open events
         # are closed with their largest energy (brk.finish)
         if turned is not None and O.time >= turned + TAIL:
-            return True
+            return "finished"
         if O.time > args.max_time:
             say(f"stopped at max_time = {args.max_time} s of simulated time")
-            return True
+            return "time_limit"
         now = time.time()
         if every >= 0 and now - last_checkpoint >= every:
             _checkpoint(out / "checkpoint.yade.gz", info, loop, args)  # --resume 1 goes on here
             last_checkpoint = now
         if stop_after and O.time >= stop_after:
-            return False                          # (tests) as if the run had died here
+            return None                           # (tests) as if the run had died here
         if now - last_report > 5.0:
             done = 0.0 if touched is None else (0.5 * (1 - max(-vz, 0.0) / v0) if turned is None
                                                 else 0.5 + 0.5 * (O.time - turned) / TAIL)
-            eta = (now - start) * (1 - done) / done if done > 0.05 else float("nan")
             say(f"t = {1e3 * O.time:.3f} ms, {len(brk.breakage_events)} breakages, "
                 f"{sum(1 for b in O.bodies if b is not None)} bodies, ball {vz:+.3f} m/s, "
-                f"wall {now - start:.0f} s, about {eta:.0f} s left")
+                f"wall {now - start:.0f} s, {time_left(now - start, done)}")
             last_report = now
 
 
@@ -147,21 +167,32 @@ def run(args, quiet=False):
     say = (lambda m: None) if quiet else progress
     brk, info, loop = _start(args, out, energy, say)
     frames = _paraview(args, out, brk, info)
-    if not _impact(brk, info, loop, args, out, start, say, frames):
+
+    def partial(end_reason, end_message):         # the outputs so far; the checkpoint is kept
+        _report(brk, info, loop, args, out, energy, time.time() - start, end_reason, end_message)
+
+    with partial_outputs_on_failure(partial):
+        ended = _impact(brk, info, loop, args, out, start, say, frames)
+    if ended is None:
         return brk, None
     brk.finish()
     frames.close()                                # the last frame, with the events closed
-    summary = _report(brk, info, loop, args, out, energy, time.time() - start)
+    summary = _report(brk, info, loop, args, out, energy, time.time() - start, ended,
+                      "" if ended == "finished" else f"stopped at --max-time {args.max_time} s")
     mark_finished(out, args)                      # --resume 1 now says so and does nothing
     (out / "checkpoint.yade.gz").unlink(missing_ok=True)    # a mid-run state, of no more use
     say(f"done in {summary['runtime_s']:.1f} s: {summary['breakage_events']} breakages, broken "
         f"mass {1e3 * summary['broken_mass']:.3f} g ({100 * summary['broken_mass_fraction']:.1f} "
         f"%), capture radius {1e3 * summary['capture_radius']:.1f} mm; outputs in {out}")
+    why = why_it_took_longer(summary)
+    if why:
+        say(f"{summary['steps']} steps: {why}")
     return brk, summary
 
 
-def _report(brk, info, loop, args, out, energy, runtime):
-    """summary.json, the size distribution (CSV and plot) and the top view."""
+def _report(brk, info, loop, args, out, energy, runtime, end_reason, end_message):
+    """summary.json (with how the run ended), the size distribution (CSV and plot) and the top
+    view."""
     initial_mass = loop["initial_mass"]
     sieves = np.geomspace(1e-5, 2 * args.size, 80)
     sd = brk.size_distribution(sieves)
@@ -178,8 +209,11 @@ def _report(brk, info, loop, args, out, energy, runtime):
         "breakage_events": len(brk.breakage_events),
         "damage_events": sum(1 for e in brk.events if e["kind"] == "damage"),
         "particles_broken": fates.count("broken"), "particles_damaged": fates.count("damaged"),
-        "simulated_time": O.time, "steps": O.iter, "final_dt": O.dt, "runtime_s": runtime,
+        "energy_per_bed_mass": energy / initial_mass,
+        "simulated_time": O.time, "steps": O.iter, "initial_dt": loop.get("initial_dt"),
+        "final_dt": O.dt, "finest_sphere_size": finest_sphere_size(), "runtime_s": runtime,
         "wall_time_read_s": brk.wall_time["read"], "wall_time_replace_s": brk.wall_time["replace"],
+        "end_reason": end_reason, "end_message": end_message,
     }
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
     with open(out / "size_distribution.csv", "w", newline="") as f:

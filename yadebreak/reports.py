@@ -3,6 +3,8 @@ progeny size distribution and t10 against Eqs. 8 and 10, and the two-panel plot.
 `brk` is any object with `events` and `size_distribution` (the coupling's controller)."""
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+
 import numpy as np
 
 from . import model
@@ -69,46 +71,130 @@ def first_events(events, ids):
 MARKERS = (2.0, 4.0, 10.0, 25.0)
 
 
+#: sieves of the progeny curves, as fractions of the particle size
+RELATIVE_SIEVES = np.geomspace(1e-3, 0.99, 40)
+
+
+@dataclass
+class ImpactTally:
+    """What impacts of particles of one size leave for their result, added up over independent
+    scenes (plain numbers: a run's scenes are built, tallied and dropped one by one).
+
+    first: each fired particle's first event (the impact itself; none for a particle with no
+    event); e_cum_intact: Ab-T10's e_cum (J/kg) of the particles that did not break;
+    progeny_mass and marker_mass: mass (kg) passing size x RELATIVE_SIEVES and size / MARKERS
+    (every fragment, fines included); masses (kg) of the scenes at their start and end."""
+    size: float
+    particles: int = 0
+    first: list = field(default_factory=list)
+    e_cum_intact: list = field(default_factory=list)
+    progeny_mass: np.ndarray = None
+    marker_mass: np.ndarray = None
+    breakage_events: int = 0
+    initial_mass: float = 0.0
+    final_mass: float = 0.0
+    scenes: int = 0
+    steps: int = 0
+    scenes_at_step_limit: int = 0
+
+    def __post_init__(self):
+        if self.progeny_mass is None:
+            self.progeny_mass = np.zeros(len(RELATIVE_SIEVES))
+            self.marker_mass = np.zeros(len(MARKERS))
+
+    def add(self, brk, ids, initial_mass):
+        """Add the scene of controller `brk`, whose fired particles are `ids` and whose mass was
+        `initial_mass` (kg) at the start."""
+        first = first_events(brk.events, ids)
+        broken = {i for i, e in first.items() if e["kind"] == "breakage"}
+        self.particles += len(ids)
+        self.first += list(first.values())
+        self.e_cum_intact += [brk.bodies[i].e_cum for i in ids
+                              if i not in broken and i in brk.bodies]
+        if broken:
+            self.progeny_mass += brk.size_distribution(self.size * RELATIVE_SIEVES).passing_mass
+            self.marker_mass += brk.size_distribution(self.size / np.array(MARKERS)).passing_mass
+        self.breakage_events += len(brk.breakage_events)
+        self.initial_mass += initial_mass
+        self.final_mass += brk.total_mass()
+        self.scenes += 1
+
+    def merge(self, other):
+        """Add another tally of particles of the same size (another process's scenes)."""
+        for name in ("particles", "breakage_events", "initial_mass", "final_mass", "scenes",
+                     "steps", "scenes_at_step_limit"):
+            setattr(self, name, getattr(self, name) + getattr(other, name))
+        self.first += other.first
+        self.e_cum_intact += other.e_cum_intact
+        self.progeny_mass = self.progeny_mass + other.progeny_mass
+        self.marker_mass = self.marker_mass + other.marker_mass
+
+    def to_dict(self):
+        """Plain JSON types (a worker process hands its tally over in a file)."""
+        out = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        out.update(progeny_mass=self.progeny_mass.tolist(), marker_mass=self.marker_mass.tolist(),
+                   e_cum_intact=[float(e) for e in self.e_cum_intact])
+        return out
+
+    @classmethod
+    def from_dict(cls, data):
+        return cls(**{**data, "progeny_mass": np.array(data["progeny_mass"]),
+                      "marker_mass": np.array(data["marker_mass"])})
+
+    @property
+    def broken(self):
+        """The first events that were breakages."""
+        return [e for e in self.first if e["kind"] == "breakage"]
+
+    @property
+    def mass_relative_error(self):
+        return abs(self.final_mass - self.initial_mass) / self.initial_mass
+
+
 def breakage_result(brk, ids, material, size, specific_energy, partner):
-    """Broken fraction of the particles `ids` beside the model's probability P(e Ek/mp), and the
+    """breakage_result_of(the tally of one scene: controller `brk`, fired particles `ids`)."""
+    tally = ImpactTally(size)
+    tally.add(brk, ids, brk.total_mass())
+    return breakage_result_of(tally, material, specific_energy, partner)
+
+
+def breakage_result_of(tally, material, specific_energy, partner):
+    """Broken fraction of the fired particles beside the model's probability P(e Ek/mp), and the
     progeny of the broken ones (fines included, every generation of fragments) beside the model
     at that energy: t10 against Eq. 7 (material.t10_model: the absorbed energy e Ek/mp over the
     median fracture energy of the particles that break at it; Ab-T10: Eq. 9.4), the passing at
     1/2, 1/4 and 1/25 of the original size against Eq. 10 at that t10, and the whole curve.
-    Also the mean t10' of the primary breakage events (Eq. 8 or 9.4), for the record."""
-    first = first_events(brk.events, ids)
-    broken = [e for e in first.values() if e["kind"] == "breakage"]
+    Also the mean t10' of the primary breakage events (Eq. 8 or 9.4), for the record.
+    `tally`: an ImpactTally."""
+    size, n = tally.size, tally.particles
+    broken = tally.broken
     p_model = float(material.breakage_probability(specific_energy, size, partner=partner))
-    n = len(ids)
     t10_model = float(material.t10_model(specific_energy, size, partner))
     result = {"specific_energy": specific_energy, "particles": n,
               "broken_fraction": len(broken) / n, "model_probability": p_model,
               "binomial_sigma": float(np.sqrt(p_model * (1 - p_model) / n)),
               "t10_model": t10_model if np.isfinite(t10_model) else None}
-    if material.is_ab_t10:
+    if material.is_ab_t10 and tally.e_cum_intact:
         # the e_cum the intact particles carry: what the broken ones would have reached
-        broken_ids = {e["id"] for e in broken}
-        e_cum = [brk.bodies[i].e_cum for i in ids if i not in broken_ids and i in brk.bodies]
-        if e_cum:
-            result["e_cum_measured"] = float(np.mean(e_cum))
-            result["p_of_e_cum_measured"] = float(material.fracture_energy_cdf(np.mean(e_cum), size))
+        e_cum = float(np.mean(tally.e_cum_intact))
+        result["e_cum_measured"] = e_cum
+        result["p_of_e_cum_measured"] = float(material.fracture_energy_cdf(e_cum, size))
     if not broken:
         result["t10_note"] = "no particle broke: no progeny to measure"
         return result
     parent_mass = sum(e["mass"] for e in broken)
-    sieves = size * np.geomspace(1e-3, 0.99, 40)    # below the feed size: progeny only
-    passing = 100 * brk.size_distribution(sieves).passing_mass / parent_mass
-    markers = 100 * brk.size_distribution(size / np.array(MARKERS)).passing_mass / parent_mass
+    passing = 100 * tally.progeny_mass / parent_mass
+    markers = 100 * tally.marker_mass / parent_mass
     result.update({
         "t10_simulated": float(markers[MARKERS.index(10.0)]),
         "t10_primary_events": float(np.mean([e["t10"] for e in broken])),
-        "breakage_events_all_generations": len(brk.breakage_events),
+        "breakage_events_all_generations": tally.breakage_events,
         "progeny_markers": {f"t{n:g}": {"simulated": float(sim), "model": _t_n(material, t10_model, n)}
                             for n, sim in zip(MARKERS, markers)},
-        "relative_sizes": (sieves / size).tolist(),
+        "relative_sizes": RELATIVE_SIEVES.tolist(),
         "progeny_passing_simulated": passing.tolist(),
         "progeny_passing_model": (model.progeny_passing(t10_model, material.beta_params,
-                                                        sieves / size).tolist()
+                                                        RELATIVE_SIEVES).tolist()
                                   if np.isfinite(t10_model) else None)})
     return result
 
@@ -174,6 +260,15 @@ def plot_breakage(results, material, size, partner, title, path, label="simulati
     plt.close(fig)
 
 
+def bounded_errors(values, errors, lo=0.0, hi=None):
+    """matplotlib's yerr (2 x n: below, above) for `values` +- `errors`, cut at `lo` and `hi`: a
+    share, a mass or a radius has no error bar below zero (nor a share above 100 %)."""
+    values, errors = np.asarray(values, float), np.abs(np.asarray(errors, float))
+    below = np.minimum(errors, values - lo) if lo is not None else errors
+    above = np.minimum(errors, hi - values) if hi is not None else errors
+    return np.vstack([np.clip(below, 0.0, None), np.clip(above, 0.0, None)])
+
+
 def _plot_probability(ax, results, material, size, partner, energies, title, label):
     grid = np.geomspace(min(energies) / 3, max(energies) * 3, 200)
     ax.semilogx(grid, 100 * material.breakage_probability(grid, size, partner=partner), "k-",
@@ -184,8 +279,9 @@ def _plot_probability(ax, results, material, size, partner, energies, title, lab
     if measured:
         ax.plot(*zip(*[(e, 100 * p) for e, p in measured]), "kx", ms=8,
                 label="P(e_cum) at the e_cum measured")
-    ax.errorbar(energies, [100 * r["broken_fraction"] for r in results],
-                yerr=[np.clip(300 * r["binomial_sigma"], 0.0, None) for r in results], fmt="o",
-                c="C3", label=f"{label} (3 sigma)")
+    broken = [100 * r["broken_fraction"] for r in results]
+    ax.errorbar(energies, broken, yerr=bounded_errors(broken, [300 * r["binomial_sigma"]
+                                                               for r in results], 0.0, 100.0),
+                fmt="o", c="C3", label=f"{label} (3 sigma)")
     ax.set(xlabel="specific energy Ek/mp (J/kg)", ylabel="broken (%)", title=title)
     ax.legend(loc="upper left", fontsize=8)

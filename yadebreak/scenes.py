@@ -1,7 +1,9 @@
 """Scene builders shared by the scripts and tests (coupling layer: imports yade)."""
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -49,6 +51,138 @@ def impact_scene(material="copper_ore", size=5.5e-3, speeds=(5.0,), target="stee
     O.engines = hertz_engines(ip2)
     brk = attach({"particle": material}, seed=seed, **options)
     return brk, ids
+
+
+def scene_seed(seed, scene):
+    """The seed of scene `scene` of a run seeded `seed`: `seed` itself for scene 0 (a run in one
+    scene is the run it always was), independent streams for the others."""
+    if scene == 0:
+        return int(seed)
+    return int(np.random.SeedSequence([int(seed), int(scene)]).generate_state(1)[0])
+
+
+def single_impacts(material, size, speed, particles, per_scene, seed, target="steel",
+                   event_log=None, on_scene=None, max_steps=200000, jobs=1, **options):
+    """`particles` particles fired at `speed` (m/s) normally at a plate, `per_scene` at a time in
+    independent scenes, each run to its own end (run_until_rebound with its controller).
+
+    Why scenes of a few: in one scene every particle waits for the slowest cascade, at the time
+    step of the finest fragment of any (200 ab_t10_ore particles of 12 mm at 160 J/kg: 470 s in
+    one scene; docs/high_energy.md). The particles are independent either way: nothing touches
+    across the 4-diameter spacing during an impact. Scene k is seeded scene_seed(seed, k), so
+    the result does not depend on `jobs`: with jobs > 1 the scenes are shared among that many
+    YADE processes (yadebreak/impact_worker.py), each running every jobs-th scene.
+
+    Events go to `event_log` (each with its `scene`), the running scene's to `<log>.scene.jsonl`
+    until it ends (with workers: each worker's to `<log>.workers/<worker>.jsonl`, joined at the
+    end; a failed run leaves them there). on_scene(scenes done, scenes, tally) after each scene (progress lines). A scene
+    stops after max_steps at the latest (counted in tally.scenes_at_step_limit). `material`: a
+    name or path (workers get it as text). Returns (reports.ImpactTally, steps run over all
+    scenes, the last scene's controller, None with workers)."""
+    counts = [per_scene] * (particles // per_scene) + ([particles % per_scene]
+                                                        if particles % per_scene else [])
+    spec = {"material": str(material), "size": size, "speed": speed, "seed": seed,
+            "target": target, "max_steps": max_steps, "options": options, "counts": counts}
+    if jobs > 1 and len(counts) > 1:
+        return _in_workers(spec, min(jobs, len(counts)), event_log, on_scene)
+    if event_log is not None:
+        Path(event_log).write_text("")
+    return run_scenes(spec, range(len(counts)), event_log, on_scene)
+
+
+def run_scenes(spec, which, event_log=None, on_scene=None):
+    """The scenes `which` of a single_impacts `spec`, one after the other, their events appended
+    to `event_log`: (tally, steps, the last scene's controller)."""
+    from .reports import ImpactTally
+    tally = ImpactTally(spec["size"])
+    log = None if event_log is None else Path(event_log)
+    live = None if log is None else log.with_suffix(".scene.jsonl")
+    brk, counts = None, spec["counts"]
+    for done, k in enumerate(which, start=1):
+        brk, ids = impact_scene(spec["material"], spec["size"], [spec["speed"]] * counts[k],
+                                target=spec["target"], seed=scene_seed(spec["seed"], k),
+                                event_log=None if live is None else str(live), **spec["options"])
+        initial_mass = brk.total_mass()
+        ran = run_until_rebound(ids, max_steps=spec["max_steps"], brk=brk)
+        tally.steps += ran
+        tally.scenes_at_step_limit += ran >= spec["max_steps"]
+        tally.add(brk, ids, initial_mass)
+        if log is not None:
+            with open(log, "a") as f:
+                f.writelines(json.dumps({"scene": k, **e}) + "\n" for e in brk.events)
+            brk.close()                       # the scene's log file, merged
+            live.unlink(missing_ok=True)
+        if on_scene is not None:
+            on_scene(done, len(which), tally)
+    return tally, tally.steps, brk
+
+
+def _in_workers(spec, jobs, event_log, on_scene):
+    """single_impacts in `jobs` YADE processes; their tallies merged, their logs joined in scene
+    order. A worker that fails stops the others and raises with its last words."""
+    import shutil
+    import subprocess
+    import tempfile
+    import time
+    if event_log is None:
+        folder = Path(tempfile.mkdtemp(prefix="yadebreak-impacts-"))
+    else:                                 # beside the log: a failed run leaves its events there
+        folder = Path(event_log).with_suffix(".workers")
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+    spec = {**spec, "package": str(Path(__file__).resolve().parent.parent)}
+    (folder / "spec.json").write_text(json.dumps(spec))
+    worker = str(Path(__file__).resolve().parent / "impact_worker.py")
+    errors = [open(folder / f"{j}.err", "w") for j in range(jobs)]
+    procs = [subprocess.Popen(["yade", "-n", "-x", worker, str(folder), str(j), str(jobs)],
+                              stdout=subprocess.DEVNULL, stderr=errors[j]) for j in range(jobs)]
+    try:
+        reported = 0
+        while True:
+            running = any(p.poll() is None for p in procs)
+            _check_workers(procs, folder)
+            tally = _merged(folder, jobs, spec["size"])
+            if on_scene is not None and tally.scenes > reported:
+                reported = tally.scenes
+                on_scene(reported, len(spec["counts"]), tally)
+            if not running:
+                break
+            time.sleep(0.5)
+        if tally.scenes != len(spec["counts"]):
+            raise RuntimeError(f"impact workers ran {tally.scenes} of {len(spec['counts'])} "
+                               f"scenes; their messages are in {folder}")
+        if event_log is not None:
+            events = [line for j in range(jobs) if (folder / f"{j}.jsonl").exists()
+                      for line in (folder / f"{j}.jsonl").read_text().splitlines()]
+            events.sort(key=lambda line: json.loads(line)["scene"])       # stable: in-scene order
+            Path(event_log).write_text("".join(line + "\n" for line in events))
+        shutil.rmtree(folder)
+        return tally, tally.steps, None
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.kill()
+                p.wait()
+        for f in errors:
+            f.close()
+
+
+def _check_workers(procs, folder):
+    """Raise if a worker has failed, with its last words."""
+    failed = [j for j, p in enumerate(procs) if p.poll() not in (None, 0)]
+    if failed:
+        raise RuntimeError(f"impact worker {failed[0]} failed (its events so far in {folder}): "
+                           + (folder / f"{failed[0]}.err").read_text()[-1500:])
+
+
+def _merged(folder, jobs, size):
+    from .reports import ImpactTally
+    tally = ImpactTally(size)
+    for j in range(jobs):
+        path = folder / f"{j}.tally.json"
+        if path.exists():
+            tally.merge(ImpactTally.from_dict(json.loads(path.read_text())))
+    return tally
 
 
 def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None):

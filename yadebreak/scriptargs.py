@@ -22,6 +22,9 @@ import math
 import os
 import re
 import sys
+import traceback
+import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
@@ -39,6 +42,7 @@ UNITS = {
 _NUMBER_THEN_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)\s*$")
 _TRUE, _FALSE = ("1", "true", "yes", "on"), ("0", "false", "no", "off")
 _DEBUG = False                  # --debug 1: tracebacks instead of one-line errors
+_SCRIPT_OPTIONS = set()         # the running script's option names (warnings name them)
 
 
 class ParamError(ValueError):
@@ -335,6 +339,8 @@ def script_params(params, description=None, argv=None):
     if isinstance(params, dict):
         params = _from_defaults(params)
     params = [p for p in params if p.name != "debug"] + [DEBUG]
+    _SCRIPT_OPTIONS.clear()
+    _SCRIPT_OPTIONS.update(p.name for p in params)
     if os.environ.get("YADE_BATCH"):
         from yade import O, utils
         defaults = {p.name: p.default for p in params}
@@ -369,10 +375,12 @@ class RunFinished(Exception):
 def run_script(main, *args):
     """Run a script's main(*args): a user's mistake (a bad material file, option or resume)
     becomes one line on stderr and exit code 2, as argparse does (--debug 1: the traceback);
-    --stop-after ends with 0; resuming a finished run says so and returns None.
-    The one place where scripts turn exceptions into exit codes."""
+    --stop-after ends with 0; resuming a finished run says so and returns None; any other error
+    prints its traceback and a line saying where the partial outputs are (exit 1), Ctrl-C a line
+    (exit 130). The one place where scripts turn exceptions into exit codes."""
     from .coupling.config import AttachError
     from .materials import MaterialError
+    _show_warnings_once()
     try:
         return main(*args)
     except StopRequested:
@@ -388,7 +396,66 @@ def run_script(main, *args):
         if _DEBUG:
             raise
         message = str(exc)
+    except KeyboardInterrupt:
+        progress("interrupted (Ctrl-C): the partial outputs and summary.json are kept")
+        raise SystemExit(130) from None
+    except Exception as exc:             # a failure midway: the traceback, for a bug report
+        traceback.print_exc()
+        print(f"[yadebreak] error: the run failed ({type(exc).__name__}: {exc}); partial outputs "
+              "and summary.json (end_reason 'error') are kept", file=sys.stderr, flush=True)
+        raise SystemExit(1) from None
     fail(message)
+
+
+#: summary.json's end_reason: how a run ended
+END_REASONS = ("finished", "time_limit", "error", "interrupted")
+
+
+@contextmanager
+def partial_outputs_on_failure(write):
+    """Run the block; if it fails (an error, Ctrl-C), `write(end_reason, end_message)` writes the
+    outputs so far (summary.json with end_reason 'error' or 'interrupted'), then the failure goes
+    on. --stop-after is not a failure (it stands for a killed run, which writes nothing)."""
+    try:
+        yield
+    except StopRequested:
+        raise
+    except KeyboardInterrupt:
+        _write_partial(write, "interrupted", "stopped by Ctrl-C")
+        raise
+    except Exception as exc:
+        _write_partial(write, "error", f"{type(exc).__name__}: {exc}")
+        raise
+
+
+def _write_partial(write, reason, message):
+    try:
+        write(reason, message)
+    except Exception as exc:             # the original failure matters more: say, go on
+        print(f"[yadebreak] could not write the partial outputs: {type(exc).__name__}: {exc}",
+              file=sys.stderr, flush=True)
+
+
+def _show_warnings_once():
+    """A script shows each of yadebreak's warnings once per run (one line; a run of several
+    scenes would repeat them per scene), naming the script's own option where the warning names
+    an attach() option that the script exposes (--read-period for read_period)."""
+    from .coupling.controller import YadebreakWarning
+    shown = set()
+    python_show = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if not issubclass(category, YadebreakWarning):
+            return python_show(message, category, filename, lineno, file, line)
+        if message.cause in shown:
+            return None
+        shown.add(message.cause)
+        print(f"[yadebreak] WARNING: {message.for_script(_SCRIPT_OPTIONS)} (shown once)",
+              file=sys.stderr, flush=True)
+        return None
+
+    warnings.showwarning = show       # the documented hook (warnings module); library use keeps
+    #                                   Python's own display
 
 
 def progress(message):
@@ -396,13 +463,23 @@ def progress(message):
     print(f"[yadebreak] {message}", flush=True)
 
 
+def time_left(elapsed_s, done):
+    """'about N s left' after `elapsed_s` (s) of wall time with the fraction `done` of the work
+    done; 'time left unknown' until 5 % is done (too early to extrapolate). Never negative or nan:
+    `done` is taken within [0, 1]."""
+    done = min(max(float(done), 0.0), 1.0) if math.isfinite(done) else 0.0
+    if done < 0.05 or not math.isfinite(elapsed_s):
+        return "time left unknown"
+    return f"about {max(elapsed_s, 0.0) * (1.0 - done) / done:.0f} s left"
+
+
 def resume_arguments(args):
     """The arguments that decide a run's results (not --resume, --stop-after, --out,
-    --checkpoint-every, --vtk-interval or --debug): what a resumed run must share with the one it
-    continues."""
+    --checkpoint-every, --vtk-interval, --debug or --jobs): what a resumed run must share with the
+    one it continues."""
     return {k: v for k, v in sorted(vars(args).items())
             if k not in ("resume", "out", "stop_after", "checkpoint_every", "vtk_interval",
-                         "debug")}
+                         "debug", "jobs")}
 
 
 def check_resume_arguments(saved, args, path):

@@ -24,9 +24,11 @@ CASES = {
                                          "--read-period", "1", "--seed", "2"]),
     "bed_auto": ("bed_impact", ["--rings", "2", "--energy", "2.0", "--read-period", "auto",
                                 "--seed", "3", "--global-damping", "0.3"]),
-    "single_copper": ("single_impact", ["--particles", "20", "--energies", "150,700"]),
+    # in one scene each (--scene-particles), as they were recorded before scenes of a few existed
+    "single_copper": ("single_impact", ["--particles", "20", "--energies", "150,700",
+                                        "--scene-particles", "20"]),
     "single_ab_t10": ("single_impact", ["--material", "ab_t10_ore", "--particles", "16",
-                                        "--energies", "250,600"]),
+                                        "--energies", "250,600", "--scene-particles", "16"]),
     "drop_weight": ("drop_weight", ["--particles", "8", "--energies", "150,600"]),
     "repeated_copper": ("repeated_impact", ["--particles", "40", "--impacts", "6"]),
     "repeated_ab_t10": ("repeated_impact", ["--material", "ab_t10_ore", "--size", "5.5e-3",

@@ -7,7 +7,6 @@ stepping (read schedule, time step, fragment damping).
 """
 from __future__ import annotations
 
-import sys
 import time
 import warnings
 
@@ -22,6 +21,31 @@ from .replacement import Replacer
 from .state import BREAKABLE, BROKEN, UNBREAKABLE, BodyRow, EngineState
 from .stepping import FragmentDamping, ReadSchedule, SmallestBreakable, TimeStep
 from .zeroing import OverlapZeroing
+
+
+class YadebreakWarning(RuntimeWarning):
+    """A warning of yadebreak: its `cause` (one kind of trouble, e.g. "jump"), the message and the
+    remedies, attach() options that address it, best first, as (option, advice with {} where the
+    option's name goes). The text names the first; a script names the first it exposes
+    (for_script)."""
+
+    def __init__(self, cause, message, remedies=(), purpose=""):
+        self.cause, self.message, self.remedies, self.purpose = cause, message, list(remedies), purpose
+        super().__init__(f"yadebreak: {self._text(self.remedies[:1], str)}")
+
+    def _text(self, remedies, spell):
+        if not remedies:
+            return self.message
+        option, advice = remedies[0]
+        return f"{self.message}: {advice.format(spell(option))} {self.purpose}".rstrip()
+
+    def for_script(self, exposed):
+        """The message naming the first remedy among `exposed` (a script's option names), as its
+        command line spells it (--read-period); attach()'s name if it exposes none."""
+        mine = [r for r in self.remedies if r[0] in exposed]
+        if mine:
+            return self._text(mine, lambda o: "--" + o.replace("_", "-"))
+        return self._text(self.remedies[:1], lambda o: f"{o} (an attach() option)")
 
 
 class Controller:
@@ -147,11 +171,11 @@ class Controller:
     def _still_breakable(self, i):
         return i in self.state.tracked and self.state.table.columns["kind"][i] == BREAKABLE
 
-    def _warn_once(self, cause, message):
+    def _warn_once(self, cause, message, remedies=(), purpose=""):
+        """A YadebreakWarning, once per cause for this controller (scripts: once per run)."""
         if cause not in self.state.warned:
             self.state.warned.add(cause)
-            warnings.warn(f"yadebreak: {message}", RuntimeWarning, stacklevel=3)
-            print(f"[yadebreak] WARNING: {message}", file=sys.stderr, flush=True)
+            warnings.warn(YadebreakWarning(cause, message, remedies, purpose), stacklevel=3)
 
     # -- the per-step work -----------------------------------------------------------------------
     def step(self):
@@ -177,8 +201,8 @@ class Controller:
     def _warn_jump(self, bid, rise, scale):
         self._warn_once("jump", (
             f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
-            f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s):"
-            f" reduce {self.schedule.remedy()} for an accurate t10'"))
+            f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s)"),
+            remedies=self.schedule.remedies(), purpose="for an accurate t10'")
 
     def _record(self, kind, bid, **fields):
         c = self.state.table.columns

@@ -109,11 +109,16 @@ class ReadSchedule:
             self.period = k
             find_engine(self.engine_label).iterPeriod = k
 
-    def remedy(self):
-        """The option that makes reads closer, for the warning that a read came late."""
+    def remedies(self):
+        """What makes reads closer, best first, for the warning that a read came late: (option
+        of attach(), advice with {} where the option's name goes)."""
+        closer = [("time_step_fraction", "reduce {}")]
         if self.period == 1:
-            return "time_step_fraction"
-        return {"fast": "fast_fraction", "auto": "read_fraction"}.get(self.mode, "read_period")
+            return closer
+        if self.mode == "every":
+            return [("read_period", "reduce {}")] + closer
+        own = "fast_fraction" if self.mode == "fast" else "read_fraction"
+        return [(own, "reduce {}"), ("read_period", "read every step ({} 1)")] + closer
 
     def to_list(self):
         return [self.speed_max, self.reads_since_scan]
