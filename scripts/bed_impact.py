@@ -15,8 +15,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.scriptargs import (choice, flag, integer, material_option, number,  # noqa: E402
-                                  script_params, size_option, text, time_step_option)
+from yadebreak.scriptargs import (checkpointed_run_options, choice, integer,  # noqa: E402
+                                  material_option, number, script_params, size_option,
+                                  time_step_option)
 
 args = script_params([
     material_option("the bed"),
@@ -38,13 +39,7 @@ args = script_params([
             lo=1, words=("auto", "fast"), unit="steps"),
     number("max_time", 0.02, "s", "simulated time at which the run stops at the latest", lo=0,
            lo_open=True),
-    number("vtk_interval", 1e-4, "s", "simulated time between frames of the ParaView series in "
-           "<out>/paraview (0: no series)", lo=0),
-    number("checkpoint_every", 60.0, "s", "wall time between checkpoints (< 0: none)"),
-    flag("resume", False, "continue the run that died in --out from its checkpoint"),
-    number("stop_after", 0.0, "s", "(tests) end as if killed at this simulated time (0: never)",
-           lo=0),
-    text("out", "out/bed_impact", "output folder"),
+    *checkpointed_run_options(1e-4, "out/bed_impact"),
 ], __doc__)
 
 from yadebreak import bed  # noqa: E402

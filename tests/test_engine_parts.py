@@ -170,6 +170,7 @@ def _scene(seed):
     for i, load, m in zip(ids.tolist(), loaded, st.table.columns["mass"][ids]):
         if load:
             loading.energy[i] = float(m * rng.uniform(0, 500))
+            loading.strongest[i] = (loading.energy[i], (0.0, 0.0, 1.0), 1.0, int(rng.integers(n)))
     return st, [criteria.criterion_for(m) for m in mats], loading
 
 
@@ -183,7 +184,7 @@ def test_both_judge_paths_make_the_same_decisions(seed):
                               True, 0.02, lambda kind, i, **f: records.append((kind, i, f)),
                               lambda *a: None)
         candidates = list(st.open_events.union(loading.energy))
-        plan = getattr(judge, path)(candidates, loading.energy, 3, 10, True)
+        plan = getattr(judge, path)(candidates, loading, 3, 10, True)
         broken = judge.settle(candidates, plan, loading)
         results.append((broken, records, sorted(st.open_events), plan.need, plan.order,
                         sorted(plan.limits),

@@ -40,6 +40,11 @@ BAD_VALUES = [
      "distinct numbers separated by commas, each > 0", "(J/kg)"),
     ("drop_weight", ["--max-time", "0"], "--max-time = 0", "> 0", "(s)"),
     ("repeated_impact", ["--energy", "3J"], "--energy = 3J", "> 0", "(J/kg)"),
+    ("ball_mill", ["--speed", "1"], "--speed = 1", "in (0, 1)", "(no unit)"),
+    ("ball_mill", ["--ball-filling", "0.6"], "--ball-filling = 0.6", "in (0, 0.5]", "(no unit)"),
+    ("ball_mill", ["--ore-filling", "0"], "--ore-filling = 0", "in (0, 0.5]", "(no unit)"),
+    ("ball_mill", ["--duration", "0"], "--duration = 0", "> 0", "(s)"),
+    ("ball_mill", ["--ball-size", "0.2"], "--ball-size = 0.2", "< the drum's radius 0.125", "(m)"),
 ]
 
 

@@ -255,8 +255,8 @@ DEBUG = flag("debug", False, "show the traceback of an error instead of its one 
 
 
 # options that the impact scripts share, declared once
-def material_option(of="the particles"):
-    return text("material", "copper_ore", f"material of {of}: a name of the library or a .toml file")
+def material_option(of="the particles", default="copper_ore"):
+    return text("material", default, f"material of {of}: a name of the library or a .toml file")
 
 
 def size_option(default):
@@ -266,6 +266,20 @@ def size_option(default):
 def time_step_option():
     return number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest "
                   "sphere's Rayleigh time", lo=0, lo_open=True, hi=1)
+
+
+def checkpointed_run_options(vtk_interval, out):
+    """The options of a scene run with checkpoints (bed, mill): the ParaView frame interval (s of
+    simulated time), checkpoints, --resume, --stop-after (tests) and the output folder."""
+    return [
+        number("vtk_interval", vtk_interval, "s", "simulated time between frames of the ParaView "
+               "series in <out>/paraview (0: no series)", lo=0),
+        number("checkpoint_every", 60.0, "s", "wall time between checkpoints (< 0: none)"),
+        flag("resume", False, "continue the run that died in --out from its checkpoint"),
+        number("stop_after", 0.0, "s", "(tests) end as if killed at this simulated time "
+               "(0: never)", lo=0),
+        text("out", out, "output folder"),
+    ]
 
 
 def _from_defaults(defaults):

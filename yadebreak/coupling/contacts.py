@@ -121,7 +121,7 @@ class Loading:
 
     def __init__(self):
         self.energy = {}          # body -> Ek' (J) counted now
-        self.strongest = {}       # body -> (share of energy, contact normal, sign toward body)
+        self.strongest = {}       # body -> (share of energy, contact normal, sign, the other body)
         self.touching = {}        # tracked body -> [(ContactRecord, side: 0 for id1, 1 for id2)]
         self.grew = set()         # tracked bodies with a contact that worked since the last read
 
@@ -215,7 +215,7 @@ class ContactReader:
                     share = c.share_a * own
                     energy[a] = energy.get(a, 0.0) + share
                     if share > strongest.get(a, (0.0,))[0]:
-                        strongest[a] = (share, c.geom.normal, 1.0)      # normal points a -> b
+                        strongest[a] = (share, c.geom.normal, 1.0, b)   # normal points a -> b
             if in_b:
                 touching.setdefault(b, []).append((c, 1))
                 own = total - c.offset_b
@@ -223,7 +223,7 @@ class ContactReader:
                     share = c.share_b * own
                     energy[b] = energy.get(b, 0.0) + share
                     if share > strongest.get(b, (0.0,))[0]:
-                        strongest[b] = (share, c.geom.normal, -1.0)
+                        strongest[b] = (share, c.geom.normal, -1.0, a)
         self.contacts = seen
         inherited.clear()                 # read now or gone
         return out

@@ -236,7 +236,8 @@ class Controller:
                 continue
             c["kind"][bid] = BROKEN
             event = {"specific_energy": specific, "fracture_energy": energy, "ratio": ratio,
-                     "t10": t10, "generation": int(c["generation"][bid]), "fragments": [], **extra}
+                     "t10": t10, "generation": int(c["generation"][bid]), "fragments": [],
+                     "partner": -1 if strongest is None else int(strongest[3]), **extra}
             if self.config.replacement.replace:
                 direction = (np.array([0.0, 0.0, 1.0]) if strongest is None
                              else strongest[2] * np.array(strongest[1]))
@@ -259,7 +260,7 @@ class Controller:
             raise ValueError(f"body {body_id} is not a breakable body yadebreak tracks")
         label = self.state.table.label_of(body_id)
         ek = self.criteria[label].force(self.state.table, body_id, ratio)
-        self._break_all([(body_id, ek, (ek, direction, 1.0))])
+        self._break_all([(body_id, ek, (ek, direction, 1.0, -1))])   # no partner: asked for
         return self.events[-1]
 
     def finish(self):

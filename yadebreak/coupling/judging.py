@@ -19,6 +19,8 @@ SMALL = 24
 
 # what a body needs after the criteria spoke
 NOTHING, FORGET, PAUSE, BREAK, OPEN, CLOSE_IF_UNLOADED = range(6)
+#: loading.strongest of a body whose contacts brought no energy above emin: no partner (-1)
+NO_PARTNER = (0.0, None, 0.0, -1)
 
 
 def steps_allowed(tolerance, threshold, level, rise, interval):
@@ -62,7 +64,7 @@ class Judge:
         if not candidates:
             return [], None
         plan_of = self.plan_each if len(candidates) <= SMALL else self.plan_all
-        plan = plan_of(candidates, loading.energy, interval, now_iter, fast)
+        plan = plan_of(candidates, loading, interval, now_iter, fast)
         return self.settle(candidates, plan, loading), plan.limits
 
     def _specific(self, i, e, c):
@@ -70,13 +72,14 @@ class Judge:
             e = e * self.energy_factor
         return e, e / c["mass"][i]
 
-    def plan_each(self, candidates, energy, interval, now_iter, fast):
+    def plan_each(self, candidates, loading, interval, now_iter, fast):
         """The decisions body by body (Python scalars)."""
         c = self.state.table.columns
         tracked = self.state.tracked
         n = len(candidates)
         need, order = [NOTHING] * n, [0] * n
         eks, jumps, thresholds, limits = [0.0] * n, [0.0] * n, [1.0] * n, []
+        energy = loading.energy
         for k, i in enumerate(candidates):
             if i not in tracked:
                 need[k] = FORGET
@@ -96,13 +99,14 @@ class Judge:
                 need[k] = BREAK
             elif e > before:
                 c["event_max"][i] = e
+                c["event_partner"][i] = loading.strongest.get(i, NO_PARTNER)[3]
                 need[k] = OPEN
             elif before > 0.0:
                 need[k] = CLOSE_IF_UNLOADED
             order[k], eks[k], jumps[k], thresholds[k] = crit.order, e, jump, threshold
         return Plan(need, order, eks, jumps, thresholds, limits)
 
-    def plan_all(self, candidates, energy, interval, now_iter, fast):
+    def plan_all(self, candidates, loading, interval, now_iter, fast):
         """The same decisions with numpy over all the candidates."""
         c = self.state.table.columns
         n = len(candidates)
@@ -111,7 +115,7 @@ class Judge:
         paused = (known & (c["pause_until"][ids] > now_iter) if self.pausing
                   else np.zeros(n, bool))
         active = known & ~paused
-        ek = np.fromiter(map(energy.get, candidates, repeat(0.0, n)), float, n)
+        ek = np.fromiter(map(loading.energy.get, candidates, repeat(0.0, n)), float, n)
         if self.energy_factor != 1.0:
             ek = np.where(c["generation"][ids] > 0, ek * self.energy_factor, ek)
         specific = ek / c["mass"][ids]
@@ -126,6 +130,8 @@ class Judge:
         grows = active & ~v.breaks & (ek > event_max)
         c["specific_energy"][ids[active]] = specific[active]
         c["event_max"][ids[grows]] = ek[grows]
+        c["event_partner"][ids[grows]] = [loading.strongest.get(i, NO_PARTNER)[3]
+                                          for i in ids[grows].tolist()]
         c["event_max"][ids[paused]] = 0.0
         c["specific_energy"][ids[paused]] = 0.0
         need = np.full(n, NOTHING, np.int8)
@@ -175,7 +181,8 @@ class Judge:
         event_max, mass = float(c["event_max"][bid]), float(c["mass"][bid])
         fields = self.criterion_of[c["material"][bid]].unload(table, bid)
         if fields is not None:
-            self.record("damage", bid, specific_energy=event_max / mass, **fields)
+            self.record("damage", bid, specific_energy=event_max / mass,
+                        partner=int(c["event_partner"][bid]), **fields)
         c["event_max"][bid] = c["specific_energy"][bid] = 0.0
         self.state.open_events.discard(bid)
         self.reader.restart(touching)

@@ -32,6 +32,7 @@ _COLUMNS = {
     "damage": (np.float64, 0.0),                         # 1 - E / E_initial (Ab-T10: e_cum / E)
     "specific_energy": (np.float64, 0.0),                # Ek'/m at the last read
     "event_max": (np.float64, 0.0),                      # largest Ek' of the open event (J)
+    "event_partner": (np.int64, -1),    # the body across the contact that brought most of it
     "t10": (np.float64, math.nan),      # unbreakable: first would-be t10'; dummy: its event's
     "parent_size": (np.float64, math.nan),               # dummy: the parent's diameter
     "generation": (np.int32, 0),
@@ -130,6 +131,8 @@ class BodyTable:
         if len(ids):
             table._grow(int(ids.max()))
             for name, (dtype, _) in _COLUMNS.items():
+                if name not in data["columns"]:      # a column added since the state was saved
+                    continue                          # (_grow filled it with its new-row value)
                 table.columns[name][ids] = np.asarray(data["columns"][name], dtype=float).astype(dtype)
             table.known = dict.fromkeys(ids.tolist())
         return table

@@ -1,0 +1,65 @@
+"""The ball mill (issue 15): a short run of a small mill keeps the ore's mass, stays finite, the
+drum's torque opposes its rotation (the motor does work on the charge) and the collision spectra
+count every stressing event (bad input: tests/test_script_options.py)."""
+import argparse
+import json
+import math
+
+import pytest
+
+pytestmark = pytest.mark.yade
+
+
+def _args(out, **changes):
+    values = dict(material="limestone", size=6e-3, ball_size=15e-3, drum_diameter=0.12,
+                  drum_length=0.04, lifters=6, lifter_height=6e-3, lifter_width=6e-3, speed=0.75,
+                  ball_filling=0.3, ore_filling=0.1, duration=0.06, stiffness_scale=1e-3,
+                  time_step_fraction=0.05, dmin=0.0, read_period="fast", seed=2,
+                  sample_interval=0.01, vtk_interval=0.03, checkpoint_every=-1.0, resume=False,
+                  stop_after=0.0, out=str(out))
+    values.update(changes)
+    return argparse.Namespace(**values)
+
+
+def test_a_short_mill_run_keeps_mass_stays_finite_and_the_motor_does_work(scene, tmp_path):
+    from yade import O
+    from yadebreak import mill, milling
+    brk, summary = mill.run(_args(tmp_path), quiet=True)
+    assert summary["end_reason"] == "finished"
+    assert summary["balls"] > 10 and summary["ore_particles"] > 50
+    assert summary["mass_relative_error"] < 1e-9
+    for b in O.bodies:
+        if b is not None:
+            assert all(math.isfinite(v) for v in (*b.state.pos, *b.state.vel, *b.state.angVel))
+    # the charge drags on the turning shell: the torque on the drum is against the rotation
+    assert summary["mean_power_W"] > 0 and summary["torque_arm_power_W"] > 0
+    omega = 2 * math.pi * 0.75 * milling.critical_speed(0.12, 15e-3)
+    assert summary["speed_rpm"] == pytest.approx(60 * omega / (2 * math.pi), rel=1e-12)
+    assert summary["simulated_time"] == pytest.approx(0.06, abs=300 * summary["final_dt"])
+    # the stressing events are the ore's: every damage event on an ore particle, none on a ball
+    damage = [e for e in brk.events if e["kind"] == "damage"]
+    assert damage and all(O.bodies[e["id"]].material.label == "ore" for e in damage)
+    assert json.loads((tmp_path / "summary.json").read_text()) == json.loads(json.dumps(summary))
+    # the spectra count every stressing event once, by the kind of contact that brought it
+    rates = summary["stressing_events_per_second"]
+    assert set(rates) == {"ball-ore", "ore-ore", "ore-liner"}
+    with_partner = [e for e in brk.events if e["kind"] in ("damage", "breakage")
+                    and e["partner"] >= 0]
+    assert sum(rates.values()) * summary["simulated_time"] == pytest.approx(len(with_partner))
+    assert rates["ore-ore"] > 0 and rates["ore-liner"] > 0
+    for name in ("size_distribution.csv", "breakage_rate.csv", "power.csv", "collision_spectra.csv",
+                 "mill.png",
+                 "charge.png", "events.jsonl", "paraview/spheres.pvd", "paraview/surfaces.pvd"):
+        assert (tmp_path / name).stat().st_size > 0, name
+    rows = (tmp_path / "size_distribution.csv").read_text().splitlines()
+    assert len(rows) >= 1 + 6                  # a header and a row every 0.01 s of 0.06 s
+
+
+def test_the_charge_fills_the_drum_as_asked(scene, tmp_path):
+    """Fillings are bulk volumes over the drum's volume, the bulk PACKING solid."""
+    from yadebreak import mill
+    args = _args(tmp_path)
+    balls, ores = mill.charge_counts(args)
+    volume = math.pi * 0.06 ** 2 * 0.04
+    assert balls == round(0.3 * volume * mill.PACKING / (math.pi / 6 * 0.015 ** 3))
+    assert ores == round(0.1 * volume * mill.PACKING / (math.pi / 6 * 0.006 ** 3))
