@@ -281,5 +281,9 @@ class ContactReader:
     def restore(self, data):
         if data["fields"] != list(ContactRecord.SAVED):
             raise ValueError("saved contacts have other fields than this yadebreak's")
-        self.contacts = {(row[0], row[1]): ContactRecord.restored(row[2:]) for row in data["rows"]}
+        # a contact that had separated at its last read (overlap < 0) is left out: the law erases
+        # such an interaction, and the run this continues counted its next touch from zero;
+        # YADE's saved scene may still hold the interaction
+        restored = ((row, ContactRecord.restored(row[2:])) for row in data["rows"])
+        self.contacts = {(row[0], row[1]): c for row, c in restored if c.overlap >= 0.0}
         self.inherited = {tuple(pair) for pair in data.get("inherited", ())}
