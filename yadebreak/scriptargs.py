@@ -29,6 +29,8 @@ from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
 
+from .intervals import Interval
+
 #: unit of an option -> the units accepted after a number, with their factor to that unit
 UNITS = {
     "m": {"m": "1", "cm": "1e-2", "mm": "1e-3", "um": "1e-6"},
@@ -82,15 +84,7 @@ class Param:
             return " or ".join(repr(w) for w in self.words)
         if self.kind == "text":
             return "a text"
-        if self.lo == -math.inf and self.hi == math.inf:
-            interval = "any number"
-        elif self.hi == math.inf:
-            interval = f"{'>' if self.lo_open else '>='} {self.lo:g}"
-        elif self.lo == -math.inf:
-            interval = f"{'<' if self.hi_open else '<='} {self.hi:g}"
-        else:
-            interval = (f"in {'(' if self.lo_open else '['}{self.lo:g}, {self.hi:g}"
-                        f"{')' if self.hi_open else ']'}")
+        interval = str(self.interval)
         if self.kind == "integer":
             interval = "an integer" + ("" if interval == "any number" else f" {interval}")
             if self.words:
@@ -124,9 +118,12 @@ class Param:
         unit = f" ({self.unit_text})" if self.numeric else ""
         return ParamError(f"{self.flag} = {value}: must be {self.accepted}{unit}{why}")
 
+    @property
+    def interval(self):
+        return Interval(self.lo, self.hi, self.lo_open, self.hi_open)
+
     def _in_range(self, v):
-        return (math.isfinite(v) and (v > self.lo if self.lo_open else v >= self.lo)
-                and (v < self.hi if self.hi_open else v <= self.hi))
+        return v in self.interval
 
     def _number(self, text, shown):
         """A float from `text`: a plain number (SI, parsed as float() always has), or a number

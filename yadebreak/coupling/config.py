@@ -9,6 +9,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+from ..intervals import Interval
+
+
 class AttachError(RuntimeError):
     """A scene or an option that yadebreak cannot work with; the message says what to change."""
 
@@ -27,12 +30,12 @@ class Option:
 
 
 def _number(lo=-math.inf, hi=math.inf, lo_open=False, hi_open=False, none=False):
+    accepted = Interval(lo, hi, lo_open, hi_open)
+
     def check(v):
         if v is None:
             return none
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            return False
-        return (v > lo if lo_open else v >= lo) and (v < hi if hi_open else v <= hi)
+        return not isinstance(v, bool) and isinstance(v, (int, float)) and v in accepted
     return check
 
 
