@@ -92,7 +92,7 @@ def impacts_at(args, mat, target, k, energy, out, start):
                      f"{tally.particles} broken, {tally.breakage_events} breakages, "
                      f"{time_left(now - began, done / scenes_total)} at this energy")
 
-    tally, steps, brk = scenes.single_impacts(
+    tally, brk = scenes.single_impacts(
         args.material, args.size, speed, args.particles, args.scene_particles, args.seed + k,
         target=args.target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
         jobs=args.jobs, replace=args.replace, time_step_fraction=args.time_step_fraction)
@@ -100,13 +100,12 @@ def impacts_at(args, mat, target, k, energy, out, start):
     result = reports.breakage_result_of(tally, mat, energy, target)
     intact = [e for e in tally.first if e["kind"] == "damage"]
     result.update({
-        "speed": speed, "half_v_squared": energy, "steps": steps,
-        "scenes": -(-args.particles // args.scene_particles),
+        "speed": speed, "half_v_squared": energy, "steps": tally.steps, "scenes": tally.scenes,
         "scenes_at_step_limit": tally.scenes_at_step_limit,
         "mean_specific_energy_measured": (float(np.mean([e["specific_energy"] / share
                                                          for e in intact])) if intact else None),
         "mass_relative_error": tally.mass_relative_error})
-    progress(f"{reports.result_line(result)}, {steps} steps, {time.time() - start:.1f} s")
+    progress(f"{reports.result_line(result)}, {tally.steps} steps, {time.time() - start:.1f} s")
     return brk, result
 
 

@@ -139,8 +139,8 @@ def test_one_scene_is_the_run_it_always_was(scene, tmp_path):
     events = [dict(e) for e in brk.events]
     coupling.forget()
     O.reset()
-    tally, _, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, 6, 6, 4,
-                                        event_log=str(tmp_path / "events.jsonl"))
+    tally, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, 6, 6, 4,
+                                     event_log=str(tmp_path / "events.jsonl"))
     assert reports.breakage_result_of(tally, cu, 700.0, steel) == before
     logged = [json.loads(line) for line in (tmp_path / "events.jsonl").read_text().splitlines()]
     assert logged == [{"scene": 0, **e} for e in events] and before["broken_fraction"] > 0
@@ -153,9 +153,9 @@ def test_scenes_of_a_few_fire_every_particle_and_keep_every_event(scene, tmp_pat
     from yadebreak import scenes
     log = tmp_path / "events.jsonl"
     seen = []
-    tally, steps, _ = scenes.single_impacts("copper_ore", 5.5e-3, np.sqrt(2 * 700.0), 7, 3, 4,
-                                            event_log=str(log),
-                                            on_scene=lambda k, n, t: seen.append((k, n)))
+    tally, _ = scenes.single_impacts("copper_ore", 5.5e-3, np.sqrt(2 * 700.0), 7, 3, 4,
+                                     event_log=str(log),
+                                     on_scene=lambda k, n, t: seen.append((k, n)))
     assert seen == [(1, 3), (2, 3), (3, 3)]
     assert tally.particles == 7 and len(tally.first) == 7
     logged = [json.loads(line) for line in log.read_text().splitlines()]
@@ -178,8 +178,8 @@ def test_breakage_probability_does_not_depend_on_the_scene_size(scene):
     sigma = np.sqrt(p_model * (1 - p_model) / n)
     fractions = []
     for per_scene in (n, 1):
-        tally, _, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, n, per_scene, 9,
-                                            replace=False)
+        tally, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, n, per_scene, 9,
+                                         replace=False)
         fractions.append(reports.breakage_result_of(tally, cu, 500.0, steel)["broken_fraction"])
     assert 0.25 < p_model < 0.75
     assert abs(fractions[0] - fractions[1]) < 3 * np.sqrt(2) * sigma
@@ -196,9 +196,9 @@ def test_scenes_shared_among_processes_give_the_same_run(scene, tmp_path):
     results, logs = [], []
     for jobs in (1, 2):
         log = tmp_path / f"events_{jobs}.jsonl"
-        tally, steps, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, 5, 1, 4,
-                                                event_log=str(log), jobs=jobs)
-        results.append((reports.breakage_result_of(tally, cu, 700.0, steel), steps,
+        tally, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, 5, 1, 4,
+                                         event_log=str(log), jobs=jobs)
+        results.append((reports.breakage_result_of(tally, cu, 700.0, steel), tally.steps,
                         tally.scenes, tally.mass_relative_error < 1e-12))
         logs.append(log.read_text())
     assert logs[0] == logs[1] and '"kind": "breakage"' in logs[0]

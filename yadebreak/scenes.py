@@ -75,10 +75,11 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
 
     Events go to `event_log` (each with its `scene`), the running scene's to `<log>.scene.jsonl`
     until it ends (with workers: each worker's to `<log>.workers/<worker>.jsonl`, joined at the
-    end; a failed run leaves them there). on_scene(scenes done, scenes, tally) after each scene (progress lines). A scene
-    stops after max_steps at the latest (counted in tally.scenes_at_step_limit). `material`: a
-    name or path (workers get it as text). Returns (reports.ImpactTally, steps run over all
-    scenes, the last scene's controller, None with workers)."""
+    end; a failed run leaves them there). on_scene(scenes done, scenes, tally) after each scene
+    (progress lines). A scene stops after max_steps at the latest (counted in
+    tally.scenes_at_step_limit). `material`: a name or path (workers get it as text). Returns
+    (reports.ImpactTally, with the steps of every scene; the last scene's controller, None with
+    workers)."""
     counts = [per_scene] * (particles // per_scene) + ([particles % per_scene]
                                                         if particles % per_scene else [])
     spec = {"material": str(material), "size": size, "speed": speed, "seed": seed,
@@ -92,7 +93,7 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
 
 def run_scenes(spec, which, event_log=None, on_scene=None):
     """The scenes `which` of a single_impacts `spec`, one after the other, their events appended
-    to `event_log`: (tally, steps, the last scene's controller)."""
+    to `event_log`: (tally, the last scene's controller)."""
     from .reports import ImpactTally
     tally = ImpactTally(spec["size"])
     log = None if event_log is None else Path(event_log)
@@ -114,7 +115,7 @@ def run_scenes(spec, which, event_log=None, on_scene=None):
             live.unlink(missing_ok=True)
         if on_scene is not None:
             on_scene(done, len(which), tally)
-    return tally, tally.steps, brk
+    return tally, brk
 
 
 def _in_workers(spec, jobs, event_log, on_scene):
@@ -157,7 +158,7 @@ def _in_workers(spec, jobs, event_log, on_scene):
             events.sort(key=lambda line: json.loads(line)["scene"])       # stable: in-scene order
             Path(event_log).write_text("".join(line + "\n" for line in events))
         shutil.rmtree(folder)
-        return tally, tally.steps, None
+        return tally, None
     finally:
         for p in procs:
             if p.poll() is None:

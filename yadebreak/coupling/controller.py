@@ -31,21 +31,24 @@ class YadebreakWarning(RuntimeWarning):
 
     def __init__(self, cause, message, remedies=(), purpose=""):
         self.cause, self.message, self.remedies, self.purpose = cause, message, list(remedies), purpose
-        super().__init__(f"yadebreak: {self._text(self.remedies[:1], str)}")
+        first = self.remedies[0] if self.remedies else None
+        super().__init__(f"yadebreak: {self._text(first, str)}")
 
-    def _text(self, remedies, spell):
-        if not remedies:
+    def _text(self, remedy, spell):
+        """The message with `remedy` (option, advice) advised, its option named by spell()."""
+        if remedy is None:
             return self.message
-        option, advice = remedies[0]
+        option, advice = remedy
         return f"{self.message}: {advice.format(spell(option))} {self.purpose}".rstrip()
 
     def for_script(self, exposed):
         """The message naming the first remedy among `exposed` (a script's option names), as its
         command line spells it (--read-period); attach()'s name if it exposes none."""
-        mine = [r for r in self.remedies if r[0] in exposed]
-        if mine:
+        mine = next((r for r in self.remedies if r[0] in exposed), None)
+        if mine is not None:
             return self._text(mine, lambda o: "--" + o.replace("_", "-"))
-        return self._text(self.remedies[:1], lambda o: f"{o} (an attach() option)")
+        return self._text(self.remedies[0] if self.remedies else None,
+                          lambda o: f"{o} (an attach() option)")
 
 
 class Controller:
