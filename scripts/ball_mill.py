@@ -21,8 +21,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
 from yadebreak.scriptargs import (checkpointed_run_options, integer,  # noqa: E402
-                                  material_option, number, script_params, size_option,
-                                  time_step_option)
+                                  material_option, number, read_period_option,
+                                  script_params, size_option, time_step_option)
 
 args = script_params([
     material_option("the ore", "limestone"),     # the softest ore of the library: breaks in 1 s
@@ -47,8 +47,7 @@ args = script_params([
     time_step_option(),
     number("dmin", 0.0, "m", "smallest resolved fragment; finer progeny goes to the ledger "
            "(0: --size / 3)", lo=0),
-    integer("read_period", "fast", "how often contacts are read: every k steps, 'auto' or 'fast'",
-            lo=1, words=("auto", "fast"), unit="steps"),
+    read_period_option("fast"),
     integer("seed", 1, "random seed", lo=0),
     number("sample_interval", 0.02, "s", "simulated time between samples of the size "
            "distribution and the charge", lo=0, lo_open=True),

@@ -16,8 +16,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
 from yadebreak.scriptargs import (checkpointed_run_options, choice, integer,  # noqa: E402
-                                  material_option, number, script_params, size_option,
-                                  time_step_option)
+                                  material_option, number, read_period_option,
+                                  script_params, size_option, time_step_option)
 
 args = script_params([
     material_option("the bed"),
@@ -35,8 +35,7 @@ args = script_params([
            hi_open=True),
     choice("dummies", "ledger", ("ledger", "spheres"), "the unresolved fines: a mass ledger, or "
            "dummy spheres (the paper)"),
-    integer("read_period", "fast", "how often contacts are read: every k steps, 'auto' or 'fast'",
-            lo=1, words=("auto", "fast"), unit="steps"),
+    read_period_option("fast"),
     number("max_time", 0.02, "s", "simulated time at which the run stops at the latest", lo=0,
            lo_open=True),
     *checkpointed_run_options(1e-4, "out/bed_impact"),

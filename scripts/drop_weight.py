@@ -17,6 +17,7 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 from yadebreak import load_material, reports  # noqa: E402
 from yadebreak.scriptargs import (PartialResults, flag, integer, material_option,  # noqa: E402
                                   number, numbers, partial_outputs_on_failure, progress,
+                                  read_period_option, read_period_value,
                                   run_script, script_params, size_option, text,
                                   time_step_option)
 
@@ -29,6 +30,7 @@ args = script_params([
             "mass", lo=0, lo_open=True),
     number("striker_mass_ratio", 50.0, "-", "striker mass over particle mass", lo=0, lo_open=True),
     time_step_option(),
+    read_period_option("every_step"),   # laboratory tests: the exact reference
     number("max_time", 0.003, "s", "simulated time per energy at the most", lo=0, lo_open=True),
     text("out", "out/drop_weight", "output folder"),
     flag("resume", False, "continue the run in --out, keeping the energies it finished"),
@@ -79,6 +81,7 @@ def drop_at(args, mat, steel, k, energy, out):
     brk, ids, strikers = scenes.drop_weight_scene(
         args.material, args.size, energy, args.particles, args.striker_mass_ratio,
         seed=args.seed + k, time_step_fraction=args.time_step_fraction,
+        read_period=read_period_value(args.read_period),
         event_log=str(out / f"events_{energy:g}.jsonl"))
     initial_mass = brk.total_mass()
     # until every striker rebounds (or max_time of simulated time); then open events close

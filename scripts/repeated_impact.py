@@ -24,7 +24,8 @@ from yadebreak import load_material, model, reports  # noqa: E402
 from yadebreak.scriptargs import (ScriptError, check_not_finished,  # noqa: E402
                                   check_resume_arguments, flag, integer, mark_finished,
                                   mark_started, material_option, number,
-                                  partial_outputs_on_failure, progress,
+                                  partial_outputs_on_failure, progress, read_period_option,
+                                  read_period_value,
                                   resume_arguments, run_script, script_params, size_option,
                                   stop_if_asked, text, time_step_option)
 
@@ -40,6 +41,7 @@ args = script_params([
     integer("seed", 1, "random seed", lo=0),
     text("target", "steel", "the plate: steel, rubber or a material"),
     time_step_option(),
+    read_period_option("every_step"),   # laboratory tests: the exact reference
     text("out", "out/repeated_impact", "output folder"),
     flag("resume", False, "continue the run in --out from the checkpoint after its last impact"),
     integer("stop_after", 0, "(tests) end as if killed after this many impacts (0: never)", lo=0,
@@ -75,6 +77,7 @@ def main(args):
         brk, ids = scenes.impact_scene(mat, args.size, [speed] * args.particles, target=args.target,
                                        seed=args.seed, replace=False,
                                        time_step_fraction=args.time_step_fraction,
+                                       read_period=read_period_value(args.read_period),
                                        event_log=str(out / "events.jsonl"))
         home = {i: tuple(O.bodies[i].state.pos) for i in ids}
         alive = list(ids)

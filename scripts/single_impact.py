@@ -24,7 +24,8 @@ import numpy as np  # noqa: E402
 
 from yadebreak import load_material, reports  # noqa: E402
 from yadebreak.scriptargs import (PartialResults, flag, integer, material_option,  # noqa: E402
-                                  numbers, partial_outputs_on_failure, progress, run_script,
+                                  numbers, partial_outputs_on_failure, progress, read_period_option,
+                                  read_period_value, run_script,
                                   script_params, size_option, text, time_left, time_step_option)
 
 args = script_params([
@@ -42,6 +43,7 @@ args = script_params([
             lo_open=True),
     flag("replace", True, "replace broken particles by their fragments (0: record events only)"),
     time_step_option(),
+    read_period_option("every_step"),   # laboratory tests: the exact reference
     text("out", "out/single_impact", "output folder"),
     flag("resume", False, "continue the run in --out, keeping the energies it finished"),
     integer("stop_after", 0, "(tests) end as if killed after this many energies (0: never)", lo=0,
@@ -95,7 +97,8 @@ def impacts_at(args, mat, target, k, energy, out, start):
     tally, brk = scenes.single_impacts(
         args.material, args.size, speed, args.particles, args.scene_particles, args.seed + k,
         target=args.target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
-        jobs=args.jobs, replace=args.replace, time_step_fraction=args.time_step_fraction)
+        jobs=args.jobs, replace=args.replace, time_step_fraction=args.time_step_fraction,
+        read_period=read_period_value(args.read_period))
     share = mat.energy_partition(target)
     result = reports.breakage_result_of(tally, mat, energy, target)
     intact = [e for e in tally.first if e["kind"] == "damage"]

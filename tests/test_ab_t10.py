@@ -158,7 +158,7 @@ def test_single_impact_broken_fraction_against_p_of_e_cum(scene, energy):
     from yadebreak import scenes
     n = 200
     brk, ids = scenes.impact_scene("ab_t10_ore", SIZE, [math.sqrt(2 * energy)] * n, seed=5,
-                                   replace=False)
+                                   replace=False, read_period="every_step")
     scenes.run_until_rebound(ids)
     broken = {e["id"] for e in brk.breakage_events} & set(ids)
     e_cum = [brk.bodies[i].e_cum for i in ids if i not in broken]

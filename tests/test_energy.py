@@ -23,7 +23,7 @@ def test_wall_impact_receives_e_m_v2_over_2(scene, tmp_path, target_restitution)
     path.write_text(text.replace("restitution = 0.39", f"restitution = {target_restitution}"))
     speeds = [1.0, 5.0, 20.0]
     brk, ids = scenes.impact_scene(str(path), 5.5e-3, speeds=speeds, target="steel",
-                                   time_step_fraction=0.05, emin=0.0)
+                                   time_step_fraction=0.05, emin=0.0, read_period="every_step")
     _unbreakable(brk, ids)
     scenes.run_until_rebound(ids)
     e = load_material(str(path)).energy_partition(load_material("steel"))
@@ -43,7 +43,7 @@ def test_two_equal_spheres_receive_half_each(scene):
     O.bodies[a].state.vel = (v, 0, 0)
     O.bodies[b].state.vel = (-v, 0, 0)
     O.engines = scenes.hertz_engines(ip2)
-    brk = coupling.attach({"ore": "copper_ore"}, seed=1, emin=0.0)
+    brk = coupling.attach({"ore": "copper_ore"}, seed=1, emin=0.0, read_period="every_step")
     _unbreakable(brk, [a, b])
     O.run(3000, True)
     m = O.bodies[a].state.mass

@@ -25,7 +25,8 @@ def test_options_are_grouped_with_their_defaults():
 @pytest.mark.parametrize("option, text", [
     (dict(emin=-1.0), "emin = -1.0 J: accepted >= 0"),
     (dict(cs=2), "cs = 2: accepted [0, 1]"),
-    (dict(read_period=0), "read_period = 0 steps: accepted an integer >= 1, 'auto' or 'fast'"),
+    (dict(read_period=0), "read_period = 0 steps: accepted 'fast', 'every_step', an integer >= 1 "
+                          "or 'auto'"),
     (dict(dmin=0.0), "dmin = 0.0 m: accepted > 0 or None"),
     (dict(global_damping_time=math.nan), "global_damping_time = nan s: accepted >= 0"),
 ])

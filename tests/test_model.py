@@ -79,6 +79,21 @@ def test_damage_at_the_extremes(gamma):
     assert model.damage(0.0, gamma) == 0.0
 
 
+@pytest.mark.parametrize("gamma", [0.5, 1.0, 5.0, 20.0, 50.0])
+def test_damage_of_one_ratio_is_the_arrays_damage(gamma):
+    """The scalar path (one stressing event) solves Eq. 6 like the array path: within 1e-8 where
+    D nears 1 (Eq. 6 is flat there), and both to the same accuracy on the equation itself."""
+    r = np.concatenate([[0.0, -1.0, 1.0, 2.0], np.geomspace(1e-9, 0.5, 30),
+                        1 - np.geomspace(0.49, 1e-12, 30)])
+    one = np.array([model.damage(float(x), gamma) for x in r])
+    np.testing.assert_allclose(one, model.damage(r, gamma), rtol=1e-8, atol=0)
+    live = (r > 0) & (r < 1)
+    d = one[live]
+    np.testing.assert_allclose(d, (2 * gamma / (2 * gamma - 5 * d + 5) * r[live]) ** (2 * gamma / 5),
+                               atol=1e-10, rtol=0)
+    assert isinstance(model.damage(0.3, gamma), float)
+
+
 def test_damage_by_fixed_point_from_zero_agrees():
     # The paper solves Eq. 6 "iteratively from an initial guess of D = 0".
     r, gamma = 0.6, 5.0

@@ -12,7 +12,8 @@ import numpy as np
 from . import coupling, paraview, scenes
 from .coupling._yade import O
 from .scriptargs import (check_not_finished, check_resume_arguments, mark_finished, mark_started,
-                         partial_outputs_on_failure, progress, resume_arguments, time_left)
+                         partial_outputs_on_failure, progress, read_period_value,
+                         resume_arguments, time_left)
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
 TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
@@ -59,8 +60,7 @@ def _resume(path, args):
 
 def _options(args, out):
     """attach() options from the script's arguments."""
-    read_period = (args.read_period if args.read_period in ("auto", "fast")
-                   else int(args.read_period))
+    read_period = read_period_value(args.read_period)
     options = dict(time_step_fraction=args.time_step_fraction, dummies=args.dummies,
                    read_period=read_period, event_log=str(out / "events.jsonl"))
     if args.dmin > 0:

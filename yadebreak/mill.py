@@ -22,8 +22,8 @@ from . import coupling, milling, paraview, scenes
 from .coupling._yade import O, utils, wrapper as _w
 from .coupling.stepping import smallest_rayleigh_time
 from .scriptargs import (ScriptError, check_not_finished, check_resume_arguments, mark_finished,
-                         mark_started, partial_outputs_on_failure, progress, resume_arguments,
-                         time_left)
+                         mark_started, partial_outputs_on_failure, progress, read_period_value,
+                         resume_arguments, time_left)
 
 PACKING = 0.6                    # solid fraction of a settled charge (bulk volume -> solid volume)
 SETTLE_TIME = 0.25               # s of settling under gravity, drum still, before the engine
@@ -220,8 +220,7 @@ def collision_spectra(events, info, duration):
 
 # -- the run ------------------------------------------------------------------------------------------
 def _options(args, out):
-    read_period = (args.read_period if args.read_period in ("auto", "fast")
-                   else int(args.read_period))
+    read_period = read_period_value(args.read_period)
     options = dict(time_step_fraction=args.time_step_fraction, dummies="ledger",
                    read_period=read_period, event_log=str(out / "events.jsonl"))
     options["dmin"] = args.dmin if args.dmin > 0 else args.size / 3.0

@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from types import MappingProxyType
 
+import math
+
 import numpy as np
 from scipy import special
 
@@ -134,6 +136,8 @@ def damage(ratio, gamma):
     than one unit in ln D. Safeguarded Newton on ln D, vectorised; exact to round-off.
     r <= 0 gives 0. r >= 1 is a breakage, not damage: it returns 1.
     """
+    if np.ndim(ratio) == 0 and np.ndim(gamma) == 0:
+        return _damage_one(float(ratio), float(gamma))
     ratio, gamma = np.broadcast_arrays(np.asarray(ratio, dtype=float), np.asarray(gamma, dtype=float))
     out = np.zeros(ratio.shape)
     active = (ratio > 0.0) & (ratio < 1.0)
@@ -162,6 +166,37 @@ def damage(ratio, gamma):
                 break
         out[active] = np.minimum(np.exp(y), np.nextafter(1.0, 0.0))
     return out[()] if out.ndim == 0 else out
+
+
+def _damage_one(ratio, gamma):
+    """damage() for one ratio: the same safeguarded Newton on Python floats (a stressing event
+    closes with one call; numpy's cost per call would be most of it)."""
+    if not ratio > 0.0:
+        return 0.0
+    if ratio >= 1.0:
+        return 1.0
+    log_r = math.log(ratio)
+    q = 2.0 * gamma / 5.0
+    p = 5.0 / (2.0 * gamma)
+    lo = q * (log_r + math.log(2.0 * gamma / (2.0 * gamma + 5.0)))
+    hi = q * log_r
+    y = 0.5 * (lo + hi)
+    for _ in range(100):
+        d = math.exp(y)
+        f = p * y + math.log(2.0 * gamma + 5.0 - 5.0 * d) - math.log(2.0 * gamma) - log_r
+        if f < 0.0:
+            lo = y
+        else:
+            hi = y
+        slope = 5.0 / (2.0 * gamma) - 5.0 * d / (2.0 * gamma + 5.0 - 5.0 * d)
+        y_new = y - f / slope if slope != 0.0 else math.nan
+        if not (math.isfinite(y_new) and lo < y_new < hi):
+            y_new = 0.5 * (lo + hi)
+        done = abs(y_new - y) <= 1e-15 * max(1.0, abs(y))
+        y = y_new
+        if done:
+            break
+    return min(math.exp(y), math.nextafter(1.0, 0.0))
 
 
 def weakened_fracture_energy(energy, ratio, gamma):

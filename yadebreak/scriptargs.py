@@ -260,6 +260,18 @@ def size_option(default):
     return number("size", default, "m", "particle size", lo=0, lo_open=True, hi=1)
 
 
+def read_period_option(default):
+    """--read-period: how often yadebreak reads the contacts (attach()'s read_period)."""
+    return integer("read_period", default, "how often contacts are read: 'fast' (as often as "
+                   "the loading requires), 'every_step' (exact), every k steps or 'auto'",
+                   lo=1, words=("auto", "fast", "every_step"), unit="steps")
+
+
+def read_period_value(value):
+    """attach()'s read_period from --read-period's value (a word, or k as text or a number)."""
+    return value if value in ("auto", "fast", "every_step") else int(value)
+
+
 def time_step_option():
     return number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest "
                   "sphere's Rayleigh time", lo=0, lo_open=True, hi=1)

@@ -56,7 +56,7 @@ def _boolean(v):
 
 
 def _read_period(v):
-    return v in ("auto", "fast") or _count(1)(v)
+    return v in ("auto", "fast", "every_step") or _count(1)(v)
 
 
 def _path_or_none(v):
@@ -69,9 +69,11 @@ OPTIONS = (
            "share of the tangential (shear) work counted in the stressing energy (Eq. 14)"),
     Option("emin", "reading", 1e-4, _number(0), ">= 0", "J",
            "a contact's energy counts once it holds at least this much (the paper's Emin)"),
-    Option("read_period", "reading", 1, _read_period, "an integer >= 1, 'auto' or 'fast'", "steps",
-           "how often contacts are read: every k steps; 'auto' at read_fraction of the smallest "
-           "breakable body's Rayleigh time; 'fast' as often as the loading requires"),
+    Option("read_period", "reading", "fast", _read_period,
+           "'fast', 'every_step', an integer >= 1 or 'auto'", "steps",
+           "how often contacts are read: 'fast' as often as the loading requires; 'every_step' "
+           "every contact every step (the exact reference, the same as 1); every k steps; "
+           "'auto' at read_fraction of the smallest breakable body's Rayleigh time"),
     Option("read_fraction", "reading", 0.05, _number(0, 1, lo_open=True), "(0, 1]", "-",
            "'auto': read at this fraction of the Rayleigh time of the smallest breakable body"),
     Option("fast_fraction", "reading", 0.25, _number(0, 1, lo_open=True), "(0, 1]", "-",

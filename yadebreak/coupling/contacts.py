@@ -1,75 +1,74 @@
 """Reading the stressing energy from YADE's interactions (Eqs. 14-16).
 
-ContactReader turns the real interactions that involve a tracked body into ContactRecords and,
-at each read, into the loading of each body: its counted energy Ek' (J), its most energetic
-contact, its contacts, and whether any of them still worked. The work law of YADE's
-Hertz-Mindlin contacts is one object, HertzMindlinWork. Duck-typed on YADE's interaction,
-geometry and physics objects; no yade import.
+ContactReader keeps the real interactions that involve a tracked body as columns of numbers, one
+row per contact in YADE's order, and turns each read into the loading of each body: its counted
+energy Ek' (J), its most energetic contact, and whether any of its contacts still worked. Per
+contact, Python only fetches YADE's numbers (ids, overlap, force: about 0.7 us); the work and the
+sums are numpy over all the contacts at once. The work law of YADE's Hertz-Mindlin contacts is
+HertzMindlinWork. Duck-typed on YADE's interaction container, geometry and physics objects; no
+yade import.
 """
 from __future__ import annotations
 
 import math
+from itertools import chain
+
+import numpy as np
 
 from .. import model
 
+#: up to this many real interactions a read goes contact by contact on Python scalars, beyond
+#: with numpy over all of them: measured, the scalar path costs about 1.1 us per contact, the
+#: numpy one about 0.5 us per contact plus 100 us per read
+SMALL = 150
+#: up to this many counted contact sides in a numpy read are summed one by one
+SMALL_SIDES = 48
 
-class ContactRecord:
-    """What is kept of one contact between reads (J, m, N, s).
+#: the columns of numbers kept per contact (J, m, N, s); saved with the scene in this order.
+#: offset_a, offset_b: the contact's work already counted in an earlier event of body a (b);
+#: share_a, share_b: Eq. 4's share of each body.
+FIELDS = ("overlap", "force", "work", "offset_a", "offset_b", "share_a", "share_b",
+          "shear_disp", "shear_force", "shear_work", "overlap_before", "time_before", "time_read")
 
-    offset_a, offset_b: the contact's work already counted in an earlier event of body a (b);
-    share_a, share_b: Eq. 4's share of each body. geom and phys are YADE's objects, held while the
-    contact lives and never saved."""
 
-    __slots__ = ("overlap", "force", "work", "offset_a", "offset_b", "share_a", "share_b",
-                 "shear_disp", "shear_force", "shear_work", "overlap_before", "time_before",
-                 "time_read", "geom", "phys")
-    #: the fields saved with the scene, in this order
-    SAVED = __slots__[:13]
+(_OVERLAP, _FORCE, _WORK, _OFFSET_A, _OFFSET_B, _SHARE_A, _SHARE_B, _SHEAR_DISP, _SHEAR_FORCE,
+ _SHEAR_WORK, _OVERLAP_BEFORE, _TIME_BEFORE, _TIME_READ) = range(len(FIELDS))
 
-    def __init__(self, share_a, share_b, now, geom, phys):
-        self.overlap = self.force = self.work = 0.0
-        self.offset_a = self.offset_b = 0.0
-        self.share_a, self.share_b = share_a, share_b
-        self.shear_disp = self.shear_force = self.shear_work = 0.0
-        self.overlap_before = 0.0
-        self.time_before = self.time_read = now
-        self.geom, self.phys = geom, phys
 
-    def start_here(self):
-        """Count work from the present state on, not from first touch: a contact that a fresh
-        fragment inherited overlapping (with a neighbour or a sibling) did no work on it yet;
-        counted from zero, its whole overlap, artificial part included, would count as if the
-        fragment had just been loaded through it."""
-        self.overlap = self.overlap_before = self.geom.penetrationDepth
-        self.force = self.phys.normalForce.norm()
-        self.shear_disp = self.phys.usTotal.norm()
-        self.shear_force = self.phys.shearForce.norm()
+def pair_codes(id1, id2):
+    """One int64 per pair of body ids (< 2**31), in the order given."""
+    return (np.asarray(id1, np.int64) << 32) | np.asarray(id2, np.int64)
 
-    def total(self, cs):
-        """Normal plus cs times shear work (Eq. 14), J."""
-        return self.work + cs * self.shear_work
 
-    def offset(self, side):
-        return self.offset_b if side else self.offset_a
+class _RowPairs:
+    """The rows' pairs as (smaller id, larger id), made once per read when asked: as pair_codes
+    and as tuples, and which of them are in a set of pairs."""
 
-    def share(self, side):
-        return self.share_b if side else self.share_a
+    def __init__(self, a, b):
+        self.lo, self.hi = np.minimum(a, b), np.maximum(a, b)
+        self._codes = self._tuples = None
 
-    def saved(self):
-        return [getattr(self, f) for f in self.SAVED]
-
-    @classmethod
-    def restored(cls, values):
-        record = cls.__new__(cls)
-        for f, v in zip(cls.SAVED, values):
-            setattr(record, f, v)
-        record.geom = record.phys = None
-        return record
+    def among(self, pairs):
+        """Which rows are pairs of the set `pairs`: each row looked up when the set is the larger
+        (the zeroed pairs of many fragments), else a sorted search over the set's codes."""
+        n = len(self.lo)
+        if not pairs:
+            return np.zeros(n, bool)
+        if len(pairs) >= n:
+            if self._tuples is None:
+                self._tuples = list(zip(self.lo.tolist(), self.hi.tolist()))
+            return np.fromiter(map(pairs.__contains__, self._tuples), bool, n)
+        if self._codes is None:
+            self._codes = pair_codes(self.lo, self.hi)
+        ab = np.fromiter(chain.from_iterable(pairs), np.int64, 2 * len(pairs))
+        known = np.sort(pair_codes(ab[0::2], ab[1::2]))
+        pos = np.minimum(np.searchsorted(known, self._codes), len(known) - 1)
+        return known[pos] == self._codes
 
 
 class HertzMindlinWork:
     """Eqs. 15-16 for YADE's Law2_ScGeom_MindlinPhys_Mindlin: the normal work while the overlap
-    grows, with F = kno delta^1.5 + dashpot.
+    grows, with F = kno delta^1.5 + dashpot (arrays or floats).
 
     The Hertz part is exact between two reads, 0.4 kno (d1^2.5 - d0^2.5); the dashpot part
     (total force minus kno d^1.5) by the trapezoidal rule, except from first touch, where
@@ -83,30 +82,39 @@ class HertzMindlinWork:
         return 0.8 - 0.3 / interval ** 2
 
     @staticmethod
-    def loading(c, delta, force, hertz, first_touch):
-        """Work (J) from the last read's overlap c.overlap up to delta (> c.overlap)."""
-        d0 = c.overlap
-        if not hertz:
-            return 0.5 * (c.force + force) * (delta - d0)
-        kno = c.phys.kno
-        el0 = kno * d0 * math.sqrt(d0)
+    def trapezoid(d0, f0, delta, force):
+        """Work (J) of a force going from f0 to `force` (N) as the overlap goes d0 -> delta (m)."""
+        return 0.5 * (f0 + force) * (delta - d0)
+
+    @staticmethod
+    def loading(d0, f0, kno, delta, force, first_touch):
+        """Work (J) of a Hertz contact from overlap d0 (force f0) up to delta (> d0)."""
+        el1 = kno * delta * np.sqrt(delta)
+        touching = d0 > 0.0
+        if touching.all():                      # the usual case: one formula, no np.where
+            el0 = kno * d0 * np.sqrt(d0)
+            return 0.4 * (el1 * delta - el0 * d0) + 0.5 * (f0 - el0 + force - el1) * (delta - d0)
+        d0c = np.maximum(d0, 0.0)               # the branch for d0 <= 0 does not use it
+        el0 = kno * d0c * np.sqrt(d0c)
+        return np.where(touching,
+                        0.4 * (el1 * delta - el0 * d0) + 0.5 * (f0 - el0 + force - el1) * (delta - d0),
+                        0.4 * el1 * delta + first_touch * (force - el1) * delta)
+
+    @staticmethod
+    def loading_one(d0, f0, kno, delta, force, first_touch):
+        """loading() on floats (the same operations in the same order)."""
         el1 = kno * delta * math.sqrt(delta)
         if d0 > 0.0:
-            return 0.4 * (el1 * delta - el0 * d0) + 0.5 * (c.force - el0 + force - el1) * (delta - d0)
+            el0 = kno * d0 * math.sqrt(d0)
+            return 0.4 * (el1 * delta - el0 * d0) + 0.5 * (f0 - el0 + force - el1) * (delta - d0)
         return 0.4 * el1 * delta + first_touch * (force - el1) * delta
 
     @staticmethod
-    def to_peak(c, delta, now, hertz):
-        """Work (J) from the last read up to the peak of the parabola through the last three
-        overlaps, when the overlap peaked between two reads (sparse reads); 0 if it did not."""
-        d0 = c.overlap
-        peak = (model.parabolic_peak(c.time_before, c.overlap_before, c.time_read, d0, now, delta)
-                if hertz else d0)
-        if not peak > d0:
-            return None
-        kno = c.phys.kno
+    def to_peak(d0, f0, kno, peak):
+        """Work (J) of a Hertz contact from d0 up to `peak` (> d0), where the overlap peaked
+        between two reads (sparse reads; the peak from model.parabolic_peak)."""
         el0 = kno * d0 * math.sqrt(d0)
-        return 0.4 * kno * (peak ** 2.5 - d0 ** 2.5) + 0.5 * (c.force - el0) * (peak - d0)
+        return 0.4 * kno * (peak ** 2.5 - d0 ** 2.5) + 0.5 * (f0 - el0) * (peak - d0)
 
     @staticmethod
     def stored(kno, delta):
@@ -114,176 +122,471 @@ class HertzMindlinWork:
         return 0.4 * kno * delta ** 2.5
 
 
+class StrongestContacts:
+    """body -> (share of energy (J), contact normal, sign, the other body) of its most energetic
+    contact at a read; the normal is fetched from YADE only for the bodies asked for."""
+
+    def __init__(self, found=None, geoms=None):
+        self._found = found or {}     # body -> (share, row, sign, other)
+        self._geoms = geoms
+        self._made = {}
+
+    def __setitem__(self, body, value):
+        self._made[body] = value
+
+    def __contains__(self, body):
+        return body in self._made or body in self._found
+
+    def get(self, body, default=None):
+        made = self._made.get(body)
+        if made is None:
+            found = self._found.get(body)
+            if found is None:
+                return default
+            share, row, sign, other = found
+            made = self._made[body] = (share, self._geoms[row].normal, sign, other)
+        return made
+
+
 class Loading:
     """The bodies' loading found by one read."""
 
-    __slots__ = ("energy", "strongest", "touching", "grew")
+    __slots__ = ("energy", "strongest", "grew")
 
-    def __init__(self):
-        self.energy = {}          # body -> Ek' (J) counted now
-        self.strongest = {}       # body -> (share of energy, contact normal, sign, the other body)
-        self.touching = {}        # tracked body -> [(ContactRecord, side: 0 for id1, 1 for id2)]
-        self.grew = set()         # tracked bodies with a contact that worked since the last read
+    def __init__(self, energy=None, strongest=None, grew=None):
+        self.energy = energy if energy is not None else {}   # body -> Ek' (J) counted now
+        self.strongest = strongest if strongest is not None else StrongestContacts()
+        self.grew = grew if grew is not None else set()     # tracked bodies with a contact that
+        #                                                       worked since the last read
 
 
 class ContactReader:
-    """The contacts of tracked bodies, read every time the schedule says."""
+    """The contacts of tracked bodies, read every time the schedule says: one row per contact,
+    in the order YADE lists them at the last read. Each field of FIELDS is an array (a row of
+    one block, so that a new layout gathers all of them at once)."""
 
     def __init__(self, stiffness_by_material_id, cs, emin):
         self.stiffness = stiffness_by_material_id     # YADE material id -> Hertz stiffness (Pa)
         self.cs = cs
         self.emin = emin
-        self.contacts = {}                            # (id1, id2) -> ContactRecord
-        self.inherited = set()                        # (smaller id, larger id): see inherit()
         self.law = HertzMindlinWork()
+        self.inherited = set()                        # (smaller id, larger id): see inherit()
+        self.small = SMALL                            # see SMALL (tests set it to choose a path)
+        self._set_rows(np.empty(0, np.int64), np.empty(0, np.int64),
+                       np.empty((len(FIELDS), 0)), [], [])
 
+    def _set_rows(self, a, b, data, geoms, physs, codes=True, rows=None):
+        self.a, self.b = a, b                         # body ids as YADE orders the pair
+        self.code = pair_codes(a, b) if codes else None   # None: made when _match needs them
+        # the numbers: a block FIELDS x contacts, or (after a scalar read, until numpy is needed)
+        # one list per contact
+        self._data, self._rows = data, rows
+        self.geoms, self.physs = geoms, physs          # YADE's objects (None after a restore)
+        self._by_body = None                           # see _rows_of
+        self._incomplete = any(g is None for g in geoms)   # rows without YADE's objects yet
+
+    def __len__(self):
+        return len(self.a)
+
+    @property
+    def data(self):
+        """The numbers of every contact, FIELDS x contacts (each field also as an attribute)."""
+        if self._data is None:
+            self._data = (np.array(self._rows, float).T.copy() if self._rows
+                          else np.empty((len(FIELDS), 0)))
+            self._rows = None
+        return self._data
+
+    def _value(self, row, field):
+        rows = self._rows
+        return rows[row][field] if rows is not None else float(self._data[field, row])
+
+    def _set_value(self, row, field, value):
+        if self._rows is not None:
+            self._rows[row][field] = value
+        else:
+            self._data[field, row] = value
+
+    # -- the read ----------------------------------------------------------------------------
     def read(self, interactions, bodies, tracked, zeroed, now, interval, asleep=()):
-        """One pass over the interactions; contacts that ceased drop out. `zeroed` holds the pairs
-        whose kno varies, `asleep` those of them that carry no force and are not visited now
-        (their records stay as they were: they do no work), all keyed (smaller id, larger id);
-        `interval` is the steps since the last read."""
+        """One read of the real interactions; contacts that ceased drop out. `zeroed` holds the
+        pairs whose kno varies, `asleep` those of them that carry no force and are not updated
+        now (they do no work), all keyed (smaller id, larger id); `interval` is the steps since
+        the last read."""
+        real = interactions.all(True)
+        n = len(real)
+        id1 = [i.id1 for i in real]
+        id2 = [i.id2 for i in real]
+        if n <= self.small:
+            return self._read_each(real, id1, id2, bodies, tracked, zeroed, now, interval, asleep)
+        contains = tracked.__contains__
+        in_a = np.fromiter(map(contains, id1), bool, n)
+        in_b = np.fromiter(map(contains, id2), bool, n)
+        a, b = np.fromiter(id1, np.int64, n), np.fromiter(id2, np.int64, n)
+        keep = in_a | in_b
+        if not keep.all():
+            rows = np.flatnonzero(keep)
+            real = [real[k] for k in rows.tolist()]
+            a, b, in_a, in_b = a[rows], b[rows], in_a[rows], in_b[rows]
+        fresh, restored = self._match(real, a, b, bodies, now)
+        geoms, physs = self.geoms, self.physs
+        m = len(geoms)
+        delta = np.fromiter([g.penetrationDepth for g in geoms], float, m)
+        force = np.fromiter([p.normalForce.norm() for p in physs], float, m)
+        us = fs = None
+        if self.cs > 0.0:
+            us = np.fromiter([p.usTotal.norm() for p in physs], float, m)
+            fs = np.fromiter([p.shearForce.norm() for p in physs], float, m)
+        pairs = _RowPairs(self.a, self.b) if (self.inherited or asleep or zeroed) else None
+        if self.inherited and fresh.any():
+            self._start_here(fresh & pairs.among(self.inherited), delta, force, us, fs)
+        self.inherited.clear()                 # read now or gone
+        update = None                          # every row
+        if asleep:
+            update = ~(pairs.among(asleep) & ~fresh & ~restored)
+        hertz = ~pairs.among(zeroed) if zeroed else None
+        worked = self._work(delta, force, update, hertz, now, interval)
+        if us is not None:
+            self._shear_work(us, fs, update)
+        self._by_body = None
+        return self._loading(in_a, in_b, worked)
+
+    def _read_each(self, real, id1, id2, bodies, tracked, zeroed, now, interval, asleep):
+        """The same read contact by contact on Python scalars: for a few contacts (laboratory
+        scenes), where numpy's cost per call outweighs its cost per contact."""
         cs, emin = self.cs, self.emin
+        # the columns as local names: this loop runs for every contact at every read
+        OV, F, W, OA, OB, SA, SB, SD, SF, SW, OVB, TB, TR = range(len(FIELDS))
+        law = self.law
+        first_touch = law.first_touch_factor(interval)
         inherited = self.inherited
-        work_loading, work_to_peak = self.law.loading, self.law.to_peak
-        first_touch = self.law.first_touch_factor(interval)
-        contacts = self.contacts
-        seen = {}
-        out = Loading()
-        energy, strongest, touching, grew = out.energy, out.strongest, out.touching, out.grew
-        for i in interactions:
-            a = i.id1
-            b = i.id2
+        index = dict(zip(zip(self.a.tolist(), self.b.tolist()), range(len(self.a))))
+        old_rows = self._rows if self._rows is not None else self.data.T.tolist()
+        old_geoms, old_physs = self.geoms, self.physs
+        a_list, b_list, rows, geoms, physs = [], [], [], [], []
+        energy, found, grew, by_body = {}, {}, set(), {}
+        for inter, a, b in zip(real, id1, id2):
             in_a = a in tracked
             in_b = b in tracked
             if not (in_a or in_b):
                 continue
-            key = (a, b)
-            # zeroed, asleep and inherited pairs are (smaller id, larger id); YADE's id1 may be
-            # the larger
-            pair = key if a < b else (b, a)
-            c = contacts.get(key)
+            pair = (a, b) if a < b else (b, a)
+            j = index.get((a, b))
             update = True
-            if c is None:
-                c = self._new_record(i, bodies, now)
-                if c is None:
-                    continue
-                contacts[key] = c
-                if inherited and pair in inherited:
-                    c.start_here()
-            elif c.geom is None:                  # restored from a save: YADE's objects again
-                c.geom, c.phys = i.geom, i.phys
-            elif asleep and pair in asleep:
-                update = False                    # a slack zeroed pair: no force, no work
+            if j is None:
+                geom, phys = inter.geom, inter.phys
+                ka = self.stiffness[bodies[a].material.id]
+                kb = self.stiffness[bodies[b].material.id]
+                row = [0.0, 0.0, 0.0, 0.0, 0.0, float(model.energy_partition(ka, kb)),
+                       float(model.energy_partition(kb, ka)), 0.0, 0.0, 0.0, 0.0, now, now]
+                if inherited and pair in inherited:          # see _start_here
+                    row[OV] = row[OVB] = geom.penetrationDepth
+                    row[F] = phys.normalForce.norm()
+                    if cs > 0.0:
+                        row[SD] = phys.usTotal.norm()
+                        row[SF] = phys.shearForce.norm()
+            else:
+                row = old_rows[j]
+                geom, phys = old_geoms[j], old_physs[j]
+                if geom is None:                              # restored from a save
+                    geom, phys = inter.geom, inter.phys
+                elif asleep and pair in asleep:
+                    update = False                            # a slack zeroed pair: no work
             if update:
-                g = c.geom
-                delta = g.penetrationDepth
-                force = c.phys.normalForce.norm()    # compressive while the overlap grows
-                d0 = c.overlap
-                peaked = delta < d0 and c.overlap_before < d0 and c.time_read > c.time_before
-                if delta > d0 or peaked:
-                    hertz = not (zeroed and pair in zeroed)
-                    if delta > d0:
-                        work = work_loading(c, delta, force, hertz, first_touch)
+                delta = geom.penetrationDepth
+                force = phys.normalForce.norm()
+                d0 = row[OV]
+                work = None
+                if delta > d0:
+                    if zeroed and pair in zeroed:
+                        work = law.trapezoid(d0, row[F], delta, force)
                     else:
-                        work = work_to_peak(c, delta, now, hertz)
-                    if work is not None:
-                        c.work += work
-                        if in_a:
-                            grew.add(a)
-                        if in_b:
-                            grew.add(b)
-                c.overlap_before = d0
-                c.time_before = c.time_read
-                c.time_read = now
-                c.overlap = delta
-                c.force = force
+                        work = law.loading_one(d0, row[F], phys.kno, delta, force,
+                                               first_touch)
+                elif (delta < d0 and row[OVB] < d0
+                      and row[TR] > row[TB]
+                      and not (zeroed and pair in zeroed)):
+                    peak = model.parabolic_peak(row[TB], row[OVB],
+                                                row[TR], d0, now, delta)
+                    if peak > d0:
+                        work = law.to_peak(d0, row[F], phys.kno, peak)
+                if work is not None:
+                    row[W] += work
+                    if in_a:
+                        grew.add(a)
+                    if in_b:
+                        grew.add(b)
+                row[OVB] = d0
+                row[TB] = row[TR]
+                row[TR] = now
+                row[OV] = delta
+                row[F] = force
                 if cs > 0.0:
-                    ph = c.phys
-                    us = ph.usTotal.norm()
-                    fs = ph.shearForce.norm()
-                    if us > c.shear_disp:
-                        c.shear_work += 0.5 * (c.shear_force + fs) * (us - c.shear_disp)
-                    c.shear_disp = us
-                    c.shear_force = fs
-            seen[key] = c
-            total = c.work + cs * c.shear_work
-            # both endpoints written out, not looped: this runs for every contact at every read
+                    us = phys.usTotal.norm()
+                    fs = phys.shearForce.norm()
+                    if us > row[SD]:
+                        row[SW] += 0.5 * (row[SF] + fs) * (us - row[SD])
+                    row[SD] = us
+                    row[SF] = fs
+            k = len(rows)
+            rows.append(row)
+            a_list.append(a)
+            b_list.append(b)
+            geoms.append(geom)
+            physs.append(phys)
+            total = row[W] + cs * row[SW] if cs > 0.0 else row[W]
             if in_a:
-                touching.setdefault(a, []).append((c, 0))
-                own = total - c.offset_a
+                by_body.setdefault(a, []).append((k, 0))
+                own = total - row[OA]
                 if own >= emin:
-                    share = c.share_a * own
+                    share = row[SA] * own
                     energy[a] = energy.get(a, 0.0) + share
-                    if share > strongest.get(a, (0.0,))[0]:
-                        strongest[a] = (share, c.geom.normal, 1.0, b)   # normal points a -> b
+                    if share > found.get(a, (0.0,))[0]:
+                        found[a] = (share, k, 1.0, b)
             if in_b:
-                touching.setdefault(b, []).append((c, 1))
-                own = total - c.offset_b
+                by_body.setdefault(b, []).append((k, 1))
+                own = total - row[OB]
                 if own >= emin:
-                    share = c.share_b * own
+                    share = row[SB] * own
                     energy[b] = energy.get(b, 0.0) + share
-                    if share > strongest.get(b, (0.0,))[0]:
-                        strongest[b] = (share, c.geom.normal, -1.0, a)
-        self.contacts = seen
+                    if share > found.get(b, (0.0,))[0]:
+                        found[b] = (share, k, -1.0, a)
+        self._set_rows(np.array(a_list, np.int64), np.array(b_list, np.int64), None, geoms,
+                       physs, codes=False, rows=rows)
+        self._by_body = by_body
         inherited.clear()                 # read now or gone
-        return out
+        return Loading(energy, StrongestContacts(found, geoms), grew)
 
-    def inherit(self, pairs):
-        """Pairs (ids) that fresh fragments inherit overlapping: their records, made at the next
-        read, count work from that state on (ContactRecord.start_here)."""
-        self.inherited.update((a, b) if a < b else (b, a) for a, b in pairs)
+    def _match(self, real, a, b, bodies, now):
+        """Lay the rows out as this read's contacts: known ones keep their numbers, new ones get
+        fresh rows. Returns masks of the fresh rows and of rows restored from a save."""
+        code = pair_codes(a, b)
+        n = len(code)
+        found = np.ones(n, bool)
+        if self.code is None:
+            self.code = pair_codes(self.a, self.b)
+        if not np.array_equal(code, self.code):
+            slot = np.full(n, -1)
+            if len(self.code):
+                order = np.argsort(self.code, kind="stable")
+                pos = np.minimum(np.searchsorted(self.code[order], code), len(order) - 1)
+                found = self.code[order][pos] == code
+                slot[found] = order[pos][found]
+            else:
+                found[:] = False
+            data = np.zeros((len(FIELDS), n))
+            data[:, found] = self.data[:, slot[found]]
+            new = np.flatnonzero(~found)
+            data[_TIME_BEFORE, new] = data[_TIME_READ, new] = now
+            for k in new.tolist():
+                ka = self.stiffness[bodies[int(a[k])].material.id]
+                kb = self.stiffness[bodies[int(b[k])].material.id]
+                data[_SHARE_A, k] = float(model.energy_partition(ka, kb))
+                data[_SHARE_B, k] = float(model.energy_partition(kb, ka))
+            old_geoms, old_physs = self.geoms, self.physs
+            slots = slot.tolist()
+            self._set_rows(a, b, data, [old_geoms[s] if s >= 0 else None for s in slots],
+                           [old_physs[s] if s >= 0 else None for s in slots])
+        fresh = ~found
+        restored = np.zeros(n, bool)
+        if self._incomplete:                   # fresh rows, or restored from a save
+            for k in [k for k, g in enumerate(self.geoms) if g is None]:
+                self.geoms[k], self.physs[k] = real[k].geom, real[k].phys
+                restored[k] = found[k]
+            self._incomplete = False
+        return fresh, restored
 
-    def _new_record(self, inter, bodies, now):
-        """A record for a contact seen for the first time, with Eq. 4's shares (None while YADE
-        has no geometry for it)."""
-        if inter.geom is None:
-            return None
-        ka = self.stiffness[bodies[inter.id1].material.id]
-        kb = self.stiffness[bodies[inter.id2].material.id]
-        return ContactRecord(float(model.energy_partition(ka, kb)),
-                             float(model.energy_partition(kb, ka)), now, inter.geom, inter.phys)
+    def _start_here(self, rows, delta, force, us, fs):
+        """The fresh `rows` of inherited pairs count work from the present state on, not from
+        first touch: a contact that a fresh fragment inherited overlapping (with a neighbour or
+        a sibling) did no work on it yet; counted from zero, its whole overlap, artificial part
+        included, would count as if the fragment had just been loaded through it."""
+        self.overlap[rows] = self.overlap_before[rows] = delta[rows]
+        self.force[rows] = force[rows]
+        if us is not None:
+            self.shear_disp[rows] = us[rows]
+            self.shear_force[rows] = fs[rows]
 
-    def stored_share(self, touching):
+    def _work(self, delta, force, update, hertz, now, interval):
+        """Add each updated contact's normal work since the last read; returns the rows that
+        worked."""
+        d0 = self.overlap
+        everyone = update is None
+        grows = delta > d0 if everyone else update & (delta > d0)
+        worked = grows
+        rows = np.flatnonzero(grows)
+        if len(rows):
+            f0 = self.force[rows]
+            if hertz is None:
+                kno = np.fromiter([self.physs[k].kno for k in rows.tolist()], float, len(rows))
+                work = self.law.loading(d0[rows], f0, kno, delta[rows], force[rows],
+                                        self.law.first_touch_factor(interval))
+            else:
+                work = np.empty(len(rows))
+                h = hertz[rows]
+                hr, tr = rows[h], rows[~h]
+                kno = np.fromiter([self.physs[k].kno for k in hr.tolist()], float, len(hr))
+                work[h] = self.law.loading(d0[hr], f0[h], kno, delta[hr], force[hr],
+                                           self.law.first_touch_factor(interval))
+                work[~h] = self.law.trapezoid(d0[tr], f0[~h], delta[tr], force[tr])
+            self.work[rows] += work
+        peaked = (delta < d0) & (self.overlap_before < d0) & (self.time_read > self.time_before)
+        if not everyone:
+            peaked &= update
+        for k in np.flatnonzero(peaked).tolist():        # sparse reads only: a few per impact
+            if hertz is not None and not hertz[k]:
+                continue                                 # zeroed pairs: the peak is d0, no work
+            peak = model.parabolic_peak(float(self.time_before[k]), float(self.overlap_before[k]),
+                                        float(self.time_read[k]), float(d0[k]), now,
+                                        float(delta[k]))
+            if peak > d0[k]:
+                self.work[k] += self.law.to_peak(float(d0[k]), float(self.force[k]),
+                                                 self.physs[k].kno, peak)
+                worked = worked.copy() if worked is grows else worked
+                worked[k] = True
+        where = True if everyone else update
+        data = self.data
+        np.copyto(data[_OVERLAP_BEFORE], d0, where=where)      # d0 is still the last overlap
+        np.copyto(data[_TIME_BEFORE], data[_TIME_READ], where=where)
+        np.copyto(data[_TIME_READ], now, where=where)
+        np.copyto(data[_OVERLAP], delta, where=where)
+        np.copyto(data[_FORCE], force, where=where)
+        return worked
+
+    def _shear_work(self, us, fs, update):
+        rows = us > self.shear_disp
+        if update is not None:
+            rows &= update
+        self.shear_work[rows] += 0.5 * (self.shear_force[rows] + fs[rows]) * (
+            us[rows] - self.shear_disp[rows])
+        where = True if update is None else update
+        np.copyto(self.data[_SHEAR_DISP], us, where=where)
+        np.copyto(self.data[_SHEAR_FORCE], fs, where=where)
+
+    def _loading(self, in_a, in_b, worked):
+        """Each tracked body's Ek': the sum, over its contacts whose own work holds at least
+        emin, of its share of that work; its strongest such contact; whether one worked."""
+        total = self.work + self.cs * self.shear_work if self.cs > 0.0 else self.work
+        # the two sides of each contact in YADE's order, a before b: sums in the order a loop over
+        # the contacts makes them
+        n = len(total)
+        body, counted, share = np.empty(2 * n, np.int64), np.empty(2 * n, bool), np.empty(2 * n)
+        body[0::2], body[1::2] = self.a, self.b
+        own = total - self.offset_a
+        counted[0::2] = in_a & (own >= self.emin)
+        share[0::2] = self.share_a * own
+        own = total - self.offset_b
+        counted[1::2] = in_b & (own >= self.emin)
+        share[1::2] = self.share_b * own
+        grew = set(self.a[in_a & worked].tolist())
+        grew.update(self.b[in_b & worked].tolist())
+        sides = np.flatnonzero(counted)
+        aggregate = self._aggregate_each if len(sides) <= SMALL_SIDES else self._aggregate_all
+        energy, found = aggregate(sides, body, share)
+        return Loading(energy, StrongestContacts(found, self.geoms), grew)
+
+    def _aggregate_each(self, sides, body, share):
+        """Energy and strongest contact per body, side by side (Python scalars)."""
+        energy, found = {}, {}
+        a, b = self.a, self.b
+        for s, bid, value in zip(sides.tolist(), body[sides].tolist(), share[sides].tolist()):
+            energy[bid] = energy.get(bid, 0.0) + value
+            if value > found.get(bid, (0.0,))[0]:
+                row, side = divmod(s, 2)
+                found[bid] = (value, row, -1.0 if side else 1.0, int(a[row] if side else b[row]))
+        return energy, found
+
+    def _aggregate_all(self, sides, body, share):
+        """The same with numpy over all the sides."""
+        found = {}
+        if not len(sides):
+            return {}, found
+        ids, first, group = np.unique(body[sides], return_index=True, return_inverse=True)
+        values = share[sides]
+        sums = np.bincount(group, weights=values, minlength=len(ids))
+        # strongest: the first side of each body with the largest share (a loop's strict >)
+        best = np.lexsort((sides, -values, group))
+        head = np.empty(len(best), bool)
+        head[0] = True
+        head[1:] = group[best][1:] != group[best][:-1]
+        heads = best[head]
+        for g, s, value in zip(group[heads].tolist(), sides[heads].tolist(),
+                               values[heads].tolist()):
+            if value > 0.0:
+                row, side = divmod(s, 2)
+                found[int(ids[g])] = (value, row, -1.0 if side else 1.0,
+                                      int(self.a[row] if side else self.b[row]))
+        by_first = np.argsort(first, kind="stable")     # the bodies in the order a loop met them
+        return dict(zip(ids[by_first].tolist(), sums[by_first].tolist())), found
+
+    # -- one body's contacts -------------------------------------------------------------------
+    def _rows_of(self, body):
+        """[(row, side: 0 for a, 1 for b)] of a body's contacts at the last read, in YADE's order
+        (of the tracked bodies' sides, from the scalar read; of every side, from the numpy read:
+        asked for tracked bodies only, they are the same)."""
+        if isinstance(self._by_body, dict):
+            return self._by_body.get(body, ())
+        if self._by_body is None:
+            sides = np.column_stack((self.a, self.b)).ravel()
+            order = np.argsort(sides, kind="stable")
+            self._by_body = (sides[order], order)
+        sorted_ids, order = self._by_body
+        lo, hi = np.searchsorted(sorted_ids, [body, body + 1])
+        return [divmod(int(s), 2) for s in order[lo:hi]]
+
+    def _total(self, row):
+        return self._value(row, _WORK) + self.cs * self._value(row, _SHEAR_WORK)
+
+    def stored_share(self, body):
         """Elastic energy (J) a body holds now in its counted contacts: its share of the Hertz
         energy, with kno as the law uses it (scaled for zeroed pairs)."""
         total = 0.0
-        for c, side in touching:
-            if c.total(self.cs) - c.offset(side) >= self.emin and c.overlap > 0.0:
-                total += c.share(side) * self.law.stored(c.phys.kno, c.overlap)
+        value = self._value
+        for row, side in self._rows_of(body):
+            offset = value(row, _OFFSET_B if side else _OFFSET_A)
+            overlap = value(row, _OVERLAP)
+            if self._total(row) - offset >= self.emin and overlap > 0.0:
+                share = value(row, _SHARE_B if side else _SHARE_A)
+                total += share * self.law.stored(self.physs[row].kno, overlap)
         return total
 
-    def restart(self, touching):
+    def restart(self, body):
         """Count a body's energy from now on: its offsets become its contacts' present work."""
-        for c, side in touching:
-            if side:
-                c.offset_b = c.total(self.cs)
-            else:
-                c.offset_a = c.total(self.cs)
+        for row, side in self._rows_of(body):
+            self._set_value(row, _OFFSET_B if side else _OFFSET_A, self._total(row))
 
-    def touching(self, ids):
-        """{body: [(record, side)]} for the bodies `ids`, from the contacts kept (one pass)."""
-        found = {}
-        for (a, b), c in self.contacts.items():
-            if a in ids:
-                found.setdefault(a, []).append((c, 0))
-            if b in ids:
-                found.setdefault(b, []).append((c, 1))
-        return found
+    def inherit(self, pairs):
+        """Pairs (ids) that fresh fragments inherit overlapping: their rows, made at the next
+        read, count work from that state on (see _start_here)."""
+        self.inherited.update((a, b) if a < b else (b, a) for a, b in pairs)
 
     def bodies_in_contact(self):
-        return {k for key in self.contacts for k in key}
+        return set(np.concatenate((self.a, self.b)).tolist())
 
+    # -- saved with the scene ------------------------------------------------------------------
     def to_dict(self):
-        return {"fields": list(ContactRecord.SAVED),
-                "rows": [[a, b, *c.saved()] for (a, b), c in self.contacts.items()],
+        return {"fields": list(FIELDS),
+                "rows": [[a, b, *v] for a, b, v in zip(self.a.tolist(), self.b.tolist(),
+                                                      self.data.T.tolist())],
                 "inherited": sorted(self.inherited)}
 
     def restore(self, data):
-        if data["fields"] != list(ContactRecord.SAVED):
+        if data["fields"] != list(FIELDS):
             raise ValueError("saved contacts have other fields than this yadebreak's")
         # a contact that had separated at its last read (overlap < 0) is left out: the law erases
         # such an interaction, and the run this continues counted its next touch from zero;
         # YADE's saved scene may still hold the interaction
-        restored = ((row, ContactRecord.restored(row[2:])) for row in data["rows"])
-        self.contacts = {(row[0], row[1]): c for row, c in restored if c.overlap >= 0.0}
+        rows = [r for r in data["rows"] if r[2] >= 0.0]
+        values = np.array([r[2:] for r in rows], float).reshape(len(rows), len(FIELDS))
+        self._set_rows(np.array([r[0] for r in rows], np.int64),
+                       np.array([r[1] for r in rows], np.int64), values.T.copy(),
+                       [None] * len(rows), [None] * len(rows))
         self.inherited = {tuple(pair) for pair in data.get("inherited", ())}
+
+
+def _column(k):
+    return property(lambda self: self.data[k], doc=f"{FIELDS[k]} of each contact (a view)")
+
+
+for _k, _name in enumerate(FIELDS):
+    setattr(ContactReader, _name, _column(_k))

@@ -221,7 +221,6 @@ class Controller:
         state, table = self.state, self.state.table
         c = table.columns
         new_dt = np.inf
-        self.schedule.scene_changed()
         dmin = self.config.replacement.dmin
         dmin = dmin if dmin is not None else state.top_size / 20.0
         for bid, ek, strongest in broken:
@@ -249,11 +248,13 @@ class Controller:
                              fragment_speed_excess=progeny.speed_excess)
                 self._adopt(progeny.ids)
                 self.damping.add(progeny.ids)
+                self.schedule.saw_speed(max((O.bodies[i].state.vel.norm() for i in progeny.ids),
+                                            default=0.0))
                 if progeny.smallest_radius is not None:
                     new_dt = min(new_dt, self.time_step.for_fragments(
                         progeny.smallest_radius, O.bodies[progeny.ids[0]].material))
             self._record("breakage", bid, **event)
-        self.time_step.lower(new_dt, self.reader.bodies_in_contact())
+        self.time_step.lower(new_dt, self.reader.bodies_in_contact)
         self.wall_time["replace"] += time.perf_counter() - t0
 
     def break_body(self, body_id, ratio=1.0, direction=(0.0, 0.0, 1.0)):
@@ -270,12 +271,11 @@ class Controller:
         """Close every open stressing event as if its body had unloaded (damage with the event's
         largest energy), for runs stopped once the loading is over. Returns how many."""
         state = self.state
-        touching = self.reader.touching(state.open_events)
         event_max = state.table.columns["event_max"]
         closed = 0
         for bid in list(state.open_events):
             if bid in state.tracked and event_max[bid] > 0.0:
-                self.judge.close_event(bid, touching.get(bid, ()))
+                self.judge.close_event(bid)
                 closed += 1
         state.open_events.clear()
         return closed

@@ -157,9 +157,8 @@ class Judge:
             if what == OPEN:
                 open_events.add(i)
             elif what == CLOSE_IF_UNLOADED:
-                touching = loading.touching.get(i, ())
-                if i not in loading.grew and self.reader.stored_share(touching) <= self.reader.emin:
-                    self.close_event(i, touching)
+                if i not in loading.grew and self.reader.stored_share(i) <= self.reader.emin:
+                    self.close_event(i)
             elif what == BREAK:
                 if plan.jump[k] > 0.8 * plan.threshold[k]:
                     self.warn_jump(i, plan.jump[k], plan.threshold[k])
@@ -167,13 +166,13 @@ class Judge:
             elif what == PAUSE:
                 # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
                 # did meanwhile is never counted later
-                self.reader.restart(loading.touching.get(i, ()))
+                self.reader.restart(i)
                 open_events.discard(i)
             else:
                 open_events.discard(i)
         return broken
 
-    def close_event(self, bid, touching):
+    def close_event(self, bid):
         """End of a stressing event without breakage: the criterion's damage rule (Eqs. 5-6 or
         9.2) with the event's largest Ek'; the next event starts from the present state."""
         table = self.state.table
@@ -185,4 +184,4 @@ class Judge:
                         partner=int(c["event_partner"][bid]), **fields)
         c["event_max"][bid] = c["specific_energy"][bid] = 0.0
         self.state.open_events.discard(bid)
-        self.reader.restart(touching)
+        self.reader.restart(bid)

@@ -6,10 +6,13 @@ import heapq
 import math
 
 from .. import placement
-from ._yade import O, find_engine, wrapper
+from ._yade import O, find_engine, utils, wrapper
 
 #: read_period="fast" never waits longer than this many steps between reads.
 FAST_MAX_PERIOD = 200
+#: "fast" reads: the speed of every body is looked at every this many reads (a pass over all the
+#: bodies in Python, about 1 us each: 1/64 of it per read)
+SCAN_EVERY = 64
 
 
 class SmallestBreakable:
@@ -40,10 +43,12 @@ class ReadSchedule:
     def __init__(self, options, engine_label, smallest):
         self.options = options                # config.Reading
         self.mode = options.read_period if options.read_period in ("auto", "fast") else "every"
-        self.period = 1 if self.mode != "every" else options.read_period
+        self.period = (options.read_period if isinstance(options.read_period, int)
+                       and self.mode == "every" else 1)           # "every_step": 1
         self.engine_label = engine_label
         self.smallest = smallest              # () -> (radius, id) or None
-        self.speed_max = None                 # "fast": largest body speed, last scan
+        self.scanned = None                   # "fast": largest speed at the last scan (m/s)
+        self.speed_max = None                 # "fast": the speed used at the last read (m/s)
         self.reads_since_scan = 0
         self._auto_key = None
         self._load_key = None
@@ -56,10 +61,6 @@ class ReadSchedule:
             self._auto()
         elif self.mode == "fast":
             self._fast(limits)
-
-    def scene_changed(self):
-        """Fragments appeared: they may be the fastest bodies now ("fast" rescans)."""
-        self.speed_max = None
 
     def _auto(self):
         smallest = self.smallest()
@@ -80,18 +81,19 @@ class ReadSchedule:
         - what every loaded body allows (steps_allowed), so that no body's energy passes its
           fracture energy by more than fast_tolerance of it between reads;
         - fast_fraction of the Hertz loading time of the smallest breakable sphere at twice the
-          largest speed in the scene (rescanned every 16 reads and after breakage), so that an
-          impact that begins between reads is read several times while it loads;
+          largest speed in the scene (the most energetic body's at every read, every body's every
+          SCAN_EVERY reads, fresh fragments' when they appear), so that an impact that begins
+          between reads is read several times while it loads;
         - FAST_MAX_PERIOD steps."""
         smallest = self.smallest()
         if smallest is None:
             k = FAST_MAX_PERIOD
         else:
             self.reads_since_scan += 1
-            if self.reads_since_scan >= 16 or self.speed_max is None:
+            if self.reads_since_scan >= SCAN_EVERY or self.scanned is None:
                 self.reads_since_scan = 0
-                self.speed_max = max((b.state.vel.norm() for b in O.bodies
-                                      if b is not None and b.dynamic), default=0.0)
+                self.scanned = largest_speed()
+            self.speed_max = max(self.scanned, most_energetic_speed())
             radius, bid = smallest
             if self._load_key != smallest:
                 mat = O.bodies[bid].material
@@ -120,11 +122,29 @@ class ReadSchedule:
         own = "fast_fraction" if self.mode == "fast" else "read_fraction"
         return [(own, "reduce {}"), ("read_period", "read every step ({} 1)")] + closer
 
+    def saw_speed(self, speed):
+        """Fresh fragments move at up to `speed` (m/s): the next reads count it."""
+        if self.scanned is not None:
+            self.scanned = max(self.scanned, speed)
+
     def to_list(self):
-        return [self.speed_max, self.reads_since_scan]
+        return [self.scanned, self.reads_since_scan]
 
     def restore(self, saved):
-        self.speed_max, self.reads_since_scan = saved
+        self.scanned, self.reads_since_scan = saved
+
+
+def most_energetic_speed():
+    """Speed (m/s) of the dynamic body with the most kinetic energy (YADE finds it in C++), 0 at
+    rest."""
+    _, top = utils.kineticEnergy(True)
+    return O.bodies[top].state.vel.norm() if top >= 0 else 0.0
+
+
+def largest_speed():
+    """The largest speed (m/s) of a dynamic body: a pass over every body in Python (about 1 us
+    each), made every SCAN_EVERY reads only."""
+    return max((b.state.vel.norm() for b in O.bodies if b is not None and b.dynamic), default=0.0)
 
 
 def smallest_rayleigh_time():
@@ -170,21 +190,22 @@ class TimeStep:
         return math.inf
 
     @staticmethod
-    def lower(new_dt, moving_ids):
+    def lower(new_dt, moving):
         """O.dt = new_dt, keeping the leapfrog exact across the change.
 
         YADE's Newton takes v(n+1/2) = v(n-1/2) + a dt with the new dt; across a change the right
         increment is a (dt_old + dt_new) / 2. Without the a (dt_old - dt_new) / 2 added here, a
         body in mid-contact when a breakage shrinks dt gains energy (1.9 % measured on impacts of
-        5.5 mm copper ore at 100 J/kg when dt fell 19-fold). Done for `moving_ids`, the bodies in
-        tracked contacts, the only ones with a large acceleration that yadebreak knows of."""
+        5.5 mm copper ore at 100 J/kg when dt fell 19-fold). Done for the bodies in
+        tracked contacts (`moving()`, asked only when dt falls), the only ones with a large
+        acceleration that yadebreak knows of."""
         old = O.dt
         if not new_dt < old:
             return
         newton = next((e for e in O.engines if isinstance(e, wrapper.NewtonIntegrator)), None)
         gravity = newton.gravity if newton is not None else None
         half = 0.5 * (old - new_dt)
-        for bid in moving_ids:
+        for bid in moving():
             b = O.bodies[bid]
             if b is None or not b.dynamic:
                 continue

@@ -1,0 +1,261 @@
+"""Benchmark: the engine's cost at process scale, beside plain YADE (issue 15, item 3).
+
+    /usr/bin/python3 benchmarks/bench_scale.py [--quick] [--sizes 1000,10000,100000]
+
+Two scenes of 5.5 mm copper-ore spheres in a steel box, each built for N bodies:
+- dense: a column on a cubic lattice (each sphere touching its neighbours), under gravity, pressed
+  by a piston moving down at 0.05 m/s; about three contacts per body;
+- collisional: a loose, jittered cubic lattice (solid fraction 0.155) with random velocities of
+  3 m/s and no gravity; a few percent of the bodies in contact at a time.
+Each scene runs in plain YADE (no yadebreak), with yadebreak's default (read_period="fast"), and
+with every contact read every step (read_period="every_step"), first with breakage out of reach
+(fracture energies set very high), then, for the collisional scene, with breakage in reach
+(25 m/s). Then: the cost of one breakage event at each size, the default ball mill in the three
+modes, attach() at each size, and yadebreak's memory per body.
+Prints microseconds per step and ratios measured in this run; --quick runs 1e3 and 1e4 bodies.
+"""
+import argparse
+import gc
+import resource
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
+
+import numpy as np  # noqa: E402
+
+from yadebreak import coupling, scenes  # noqa: E402
+from yadebreak.coupling._yade import O, utils  # noqa: E402
+from yadebreak.coupling.config import Config  # noqa: E402
+from yadebreak.coupling.stepping import smallest_rayleigh_time  # noqa: E402
+
+RADIUS = 2.75e-3
+#: steps run before the timing: the lattice's first contacts settle, the first collisions happen
+WARM_UP = 200
+#: the modes compared: attach() options, None for plain YADE
+MODES = {"plain": None, "default": {}, "every step": {"read_period": "every_step"}}
+
+
+def _box(lo, hi):
+    """Five steel walls (floor and sides) around [lo, hi] (m)."""
+    walls = [utils.wall(lo[2], axis=2, sense=1, material="steel")]
+    for axis in (0, 1):
+        walls.append(utils.wall(lo[axis], axis=axis, sense=1, material="steel"))
+        walls.append(utils.wall(hi[axis], axis=axis, sense=-1, material="steel"))
+    return O.bodies.append(walls)
+
+
+def _lattice(n, pitch, column=1):
+    """n points on a cubic lattice of `pitch` (m), `column` times taller than wide."""
+    side = int(np.ceil((n / column) ** (1.0 / 3.0)))
+    height = int(np.ceil(n / side ** 2))
+    k = np.arange(n)
+    return np.column_stack([k % side, (k // side) % side, k // side ** 2]) * pitch + RADIUS, side, height
+
+
+def build(kind, n, seed=1):
+    """The scene `kind` ("dense" or "collisional") of n spheres, without yadebreak."""
+    O.reset()
+    coupling.forget()
+    ip2, _ = coupling.add_materials({"ore": "copper_ore", "steel": "steel"})
+    rng = np.random.default_rng(seed)
+    if kind == "dense":
+        pitch = 2 * RADIUS * (1 - 2e-4)           # neighbours overlap by 1 um: in contact
+        centres, side, height = _lattice(n, pitch, column=4)
+    else:
+        pitch = 2 * RADIUS * 1.5                  # solid fraction 0.155
+        centres, side, height = _lattice(n, pitch)
+        # jittered by up to 0.24 diameters per axis (no overlap): collisions from the start
+        centres = centres + rng.uniform(-0.48, 0.48, centres.shape) * RADIUS
+    hi = np.array([side * pitch, side * pitch, height * pitch]) + RADIUS * 0.01
+    _box(np.full(3, -RADIUS * (0.01 if kind == "dense" else 1.0)), hi)
+    ids = O.bodies.append([utils.sphere(tuple(p), RADIUS, material="ore") for p in centres])
+    if kind == "dense":
+        top = float(centres[:, 2].max()) + RADIUS * (1 - 1e-4)
+        piston = utils.wall(top, axis=2, sense=-1, material="steel")
+        piston.state.vel = (0.0, 0.0, -0.05)
+        O.bodies.append(piston)
+        gravity = (0.0, 0.0, -9.81)
+    else:
+        v = rng.normal(size=(n, 3))
+        v *= 3.0 / np.linalg.norm(v, axis=1)[:, None]
+        for i, vi in zip(ids, v):
+            O.bodies[i].state.vel = tuple(vi)
+        gravity = (0.0, 0.0, 0.0)
+    O.engines = scenes.hertz_engines(ip2, gravity=gravity)
+    # attach()'s own time step, so that plain YADE steps alike
+    O.dt = Config.from_options().time_step.time_step_fraction * smallest_rayleigh_time()
+    return ids
+
+
+def prepare(kind, n, mode, breakable=False, speed=None):
+    """Build the scene, attach yadebreak in `mode`, and run it past its first contacts. Returns the
+    controller (None in plain YADE) and the seconds attach() took."""
+    ids = build(kind, n)
+    if speed is not None:
+        for i in ids:
+            b = O.bodies[i]
+            b.state.vel = b.state.vel * (speed / b.state.vel.norm())
+    options = MODES[mode]
+    brk, attach_s = None, 0.0
+    if options is not None:
+        t0 = time.perf_counter()
+        brk = coupling.attach({"ore": "copper_ore"}, seed=1, **options)
+        attach_s = time.perf_counter() - t0
+        if not breakable:
+            for st in brk.bodies.values():
+                st.fracture_energy = 1e30
+    coupling.run_steps(WARM_UP)
+    return brk, attach_s
+
+
+def steps_for(n):
+    """Steps timed: about 3 s of plain YADE at each size."""
+    return int(np.clip(3e8 / (n * 300), 100, 3000)) if n >= 1000 else 3000
+
+
+def rate(kind, n, mode, steps, breakable=False, speed=None):
+    """(us per step, real contacts, breakages) over `steps` steps."""
+    brk, attach_s = prepare(kind, n, mode, breakable, speed)
+    gc.collect()
+    t0 = time.perf_counter()
+    coupling.run_steps(steps)
+    elapsed = time.perf_counter() - t0
+    broken = len(brk.breakage_events) if brk is not None else 0
+    return 1e6 * elapsed / steps, O.interactions.countReal(), broken, attach_s
+
+
+def per_step(sizes):
+    print("\n1. Cost per step, breakage out of reach (us per step; ratio to plain YADE)")
+    attach_times = {}
+    for kind in ("dense", "collisional"):
+        for n in sizes:
+            steps = steps_for(n)
+            rates = {}
+            for mode in MODES:
+                rates[mode], contacts, _, attach_s = rate(kind, n, mode, steps)
+                if mode == "default":
+                    attach_times[n] = attach_s
+            plain = rates["plain"]
+            print(f"  {kind:11s} {n:7d} bodies, {contacts:6d} contacts, {steps} steps: plain "
+                  f"{plain:9.1f}; " + "; ".join(f"{m} {rates[m]:9.1f} ({rates[m] / plain:.2f}x)"
+                                                for m in MODES if m != "plain"))
+    return attach_times
+
+
+def with_breakage(sizes):
+    print("\n2. The collisional scene with breakage in reach (25 m/s)")
+    for n in sizes:
+        steps = steps_for(n)
+        rates, broken = {}, {}
+        for mode in MODES:
+            rates[mode], _, broken[mode], _ = rate("collisional", n, mode, steps, True, 25.0)
+        plain = rates["plain"]
+        print(f"  {n:7d} bodies, {steps} steps: plain {plain:9.1f}; " + "; ".join(
+            f"{m} {rates[m]:9.1f} ({rates[m] / plain:.2f}x, {broken[m]} breakages)"
+            for m in MODES if m != "plain"))
+
+
+def event_cost(sizes):
+    print("\n3. One breakage event (family at t10' = 10 %) in the dense scene: yadebreak's own work")
+    for n in sizes:
+        for dummies in ("spheres", "ledger"):
+            MODES["default"] = {"dummies": dummies}
+            brk, _ = prepare("dense", n, "default")
+            mat = brk.material["ore"]
+            ratio = -mat.kappa / mat.b_prime * np.log(1 - 10.0 / mat.A)   # Eq. 8 at 10 %
+            tracked = sorted(brk.state.tracked)
+            victims = [tracked[len(tracked) // 2 + 7 * k] for k in range(7)]
+            brk.break_body(victims[0], ratio=ratio)      # the first lowers O.dt: not counted
+            own, sizes_made = [], []
+            for v in victims[1:]:
+                before = brk.wall_time["replace"]
+                event = brk.break_body(v, ratio=ratio)
+                own.append(brk.wall_time["replace"] - before)
+                sizes_made.append(len(event["fragments"]))
+            print(f"  {n:7d} bodies, dummies as {dummies:7s}: {1e3 * np.median(own):.2f} ms per "
+                  f"event (median of 6, {1e3 * min(own):.2f}-{1e3 * max(own):.2f}; "
+                  f"{min(sizes_made)}-{max(sizes_made)} spheres made)")
+    MODES["default"] = {}
+
+
+def _mill_args(out):
+    """The default mill of scripts/ball_mill.py."""
+    from argparse import Namespace
+    return Namespace(material="limestone", size=8e-3, ball_size=25e-3, drum_diameter=0.25,
+                     drum_length=0.1, lifters=8, lifter_height=10e-3, lifter_width=10e-3,
+                     speed=0.75, ball_filling=0.3, ore_filling=0.1, duration=1.0,
+                     stiffness_scale=1e-3, time_step_fraction=0.05, dmin=0.0,
+                     read_period="fast", seed=1, sample_interval=0.02, vtk_interval=0.0,
+                     checkpoint_every=-1.0, resume=False, stop_after=0.0, out=str(out))
+
+
+def mill(steps=3000):
+    """The default mill once settled, run from the same saved state in each mode."""
+    import tempfile
+    from yadebreak import mill as mill_scene
+    print("\n4. The default ball mill (scripts/ball_mill.py), from the charge settled")
+    with tempfile.TemporaryDirectory() as out:
+        args = _mill_args(out)
+        coupling.forget()
+        mill_scene.mill_scene(args, mill_scene._options(args, Path(out)))
+        saved = str(Path(out) / "settled.yade.gz")
+        coupling.save(saved)
+        rates = {}
+        for mode, options in MODES.items():
+            coupling.forget()
+            O.load(saved)
+            if options != {}:                       # plain YADE, or attached afresh
+                coupling.detach()
+                if options is not None:
+                    coupling.attach({"ore": "limestone"}, seed=1, dmin=args.size / 3, **options)
+            t0 = time.perf_counter()
+            coupling.run_steps(steps)
+            rates[mode] = 1e6 * (time.perf_counter() - t0) / steps
+        plain = rates["plain"]
+        print(f"  {len(O.bodies)} bodies, {O.interactions.countReal()} contacts, {steps} steps: "
+              f"plain {plain:9.1f}; " + "; ".join(f"{m} {rates[m]:9.1f} ({rates[m] / plain:.2f}x)"
+                                                  for m in MODES if m != "plain"))
+
+
+def _rss():
+    """Resident memory of this process now (bytes)."""
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * resource.getpagesize()
+
+
+def memory(n):
+    """yadebreak's memory per body: resident memory of the dense scene with yadebreak attached and
+    run, less that of the same scene in plain YADE."""
+    prepare("dense", n, "plain")
+    gc.collect()
+    plain = _rss()
+    brk, _ = prepare("dense", n, "default")
+    coupling.run_steps(200)
+    gc.collect()
+    own = _rss() - plain
+    print(f"\n6. Memory, dense scene of {n} bodies: yadebreak adds {own / 2 ** 20:.0f} MB "
+          f"({own / n / 1024:.2f} kB per body; YADE's scene alone {plain / 2 ** 20:.0f} MB)")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="1e3 and 1e4 bodies only")
+    parser.add_argument("--sizes", default=None, help="comma-separated body counts")
+    args = parser.parse_args(sys.argv[1:])
+    sizes = ([int(float(s)) for s in args.sizes.split(",")] if args.sizes
+             else [1000, 10000] if args.quick else [1000, 10000, 100000])
+    attach_times = per_step(sizes)
+    with_breakage(sizes)
+    event_cost(sizes)
+    mill()
+    print("\n5. attach() on the dense scene: " + ", ".join(
+        f"{n} bodies {t:.2f} s" for n, t in attach_times.items()))
+    memory(max(sizes))
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    print(f"peak memory of this process {peak:.0f} MB")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,53 @@
+"""The contact reader's two paths (contact by contact on Python scalars for a few contacts, numpy
+over all of them for many) read the same scene alike: the same rows, numbers, energies, strongest
+contacts and growing bodies, bit for bit, through impacts, breakage, zeroed and sleeping pairs
+and inherited contacts, with and without shear work."""
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.yade
+
+
+def _same_loading(x, y):
+    assert list(x.energy.items()) == list(y.energy.items())      # values and order
+    assert x.grew == y.grew
+    for body in x.energy:
+        sx, sy = x.strongest.get(body), y.strongest.get(body)
+        assert (sx is None) == (sy is None)
+        if sx is not None:
+            assert sx[0] == sy[0] and sx[2:] == sy[2:] and tuple(sx[1]) == tuple(sy[1])
+
+
+@pytest.mark.parametrize("cs", [0.0, 0.5])
+def test_both_paths_read_a_breaking_bed_alike(scene, cs):
+    from yadebreak import coupling, scenes
+    from yadebreak.coupling.contacts import ContactReader
+    brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 3, 1, 6.0, seed=4, read_period=1,
+                                        dummies="spheres", cs=cs)
+    O = scene
+    each, full = (ContactReader(brk.reader.stiffness, cs, brk.reader.emin) for _ in range(2))
+    each.small, full.small = 10 ** 9, -1
+    while not any(O.interactions.withBody(info["ball"])):
+        coupling.run_steps(50)
+    scenes.hold_release(info)
+    reads = 0
+    seen = {"zeroed": 0, "asleep": 0, "inherited": 0}
+    for step in range(4000):
+        O.step()
+        for r in (each, full):
+            r.inherited = set(brk.reader.inherited)
+        for what, pairs in (("zeroed", brk.zeroing.pairs), ("asleep", brk.zeroing.asleep),
+                            ("inherited", brk.reader.inherited)):
+            seen[what] = max(seen[what], len(pairs))
+        if step % 3:                         # every third step: sparse reads and peaks too
+            continue
+        state = brk.state
+        args = (O.interactions, O.bodies, state.tracked, brk.zeroing.pairs, O.time, 3,
+                brk.zeroing.asleep)
+        _same_loading(each.read(*args), full.read(*args))
+        assert np.array_equal(each.a, full.a) and np.array_equal(each.b, full.b)
+        assert np.array_equal(each.data, full.data)
+        reads += 1
+    assert brk.breakage_events, "the bed must break for the comparison to mean something"
+    assert min(seen.values()) > 10, seen    # zeroed, sleeping and inherited pairs were read
+    assert len(full) > 0 and reads > 1000
