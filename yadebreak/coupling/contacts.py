@@ -171,13 +171,13 @@ class ContactReader:
         self.emin = emin
         self.law = HertzMindlinWork()
         self.inherited = set()                        # (smaller id, larger id): see inherit()
+        self._erased = set()                          # bodies gone since the last read
         self.small = SMALL                            # see SMALL (tests set it to choose a path)
         self._set_rows(np.empty(0, np.int64), np.empty(0, np.int64),
                        np.empty((len(FIELDS), 0)), [], [])
 
-    def _set_rows(self, a, b, data, geoms, physs, codes=True, rows=None):
+    def _set_rows(self, a, b, data, geoms, physs, rows=None):
         self.a, self.b = a, b                         # body ids as YADE orders the pair
-        self.code = pair_codes(a, b) if codes else None   # None: made when _match needs them
         # the numbers: a block FIELDS x contacts, or (after a scalar read, until numpy is needed)
         # one list per contact
         self._data, self._rows = data, rows
@@ -208,30 +208,23 @@ class ContactReader:
             self._data[field, row] = value
 
     # -- the read ----------------------------------------------------------------------------
-    def read(self, interactions, bodies, tracked, zeroed, now, interval, asleep=()):
+    def read(self, interactions, bodies, tracked, zeroed, now, interval, asleep=(), counts=None):
         """One read of the real interactions; contacts that ceased drop out. `zeroed` holds the
         pairs whose kno varies, `asleep` those of them that carry no force and are not updated
         now (they do no work), all keyed (smaller id, larger id); `interval` is the steps since
-        the last read."""
-        real = interactions.all(True)
-        n = len(real)
-        id1 = [i.id1 for i in real]
-        id2 = [i.id2 for i in real]
-        if n <= self.small:
-            return self._read_each(real, id1, id2, bodies, tracked, zeroed, now, interval, asleep)
-        contains = tracked.__contains__
-        in_a = np.fromiter(map(contains, id1), bool, n)
-        in_b = np.fromiter(map(contains, id2), bool, n)
-        a, b = np.fromiter(id1, np.int64, n), np.fromiter(id2, np.int64, n)
-        keep = in_a | in_b
-        if not keep.all():
-            rows = np.flatnonzero(keep)
-            real = [real[k] for k in rows.tolist()]
-            a, b, in_a, in_b = a[rows], b[rows], in_a[rows], in_b[rows]
-        fresh, restored = self._match(real, a, b, bodies, now)
-        geoms, physs = self.geoms, self.physs
-        m = len(geoms)
-        delta = np.fromiter([g.penetrationDepth for g in geoms], float, m)
+        the last read; `counts()` gives the real interactions of each body id (YADE's
+        numIntrsOfEachBody, in C++): with it, a read of many contacts looks for new ones only
+        around the bodies whose count changed (_screen)."""
+        if counts is None or len(self) <= self.small:
+            real = interactions.all(True)
+            return self._read_each(real, [i.id1 for i in real], [i.id2 for i in real], bodies,
+                                   tracked, zeroed, now, interval, asleep)
+        mask = np.zeros(len(bodies), bool)              # tracked, by body id
+        if tracked:
+            mask[np.fromiter(tracked, np.int64, len(tracked))] = True
+        fresh, restored, delta = self._screen(interactions, bodies, mask, counts, now)
+        physs = self.physs
+        m = len(physs)
         force = np.fromiter([p.normalForce.norm() for p in physs], float, m)
         us = fs = None
         if self.cs > 0.0:
@@ -241,6 +234,7 @@ class ContactReader:
         if self.inherited and fresh.any():
             self._start_here(fresh & pairs.among(self.inherited), delta, force, us, fs)
         self.inherited.clear()                 # read now or gone
+        self._erased.clear()
         update = None                          # every row
         if asleep:
             update = ~(pairs.among(asleep) & ~fresh & ~restored)
@@ -249,7 +243,94 @@ class ContactReader:
         if us is not None:
             self._shear_work(us, fs, update)
         self._by_body = None
-        return self._loading(in_a, in_b, worked)
+        return self._loading(mask[self.a], mask[self.b], worked)
+
+    def _screen(self, interactions, bodies, mask, counts, now):
+        """The rows laid out as the contacts of tracked bodies now, without a pass over every
+        interaction: a row whose overlap is negative was erased by the law at its last step (its
+        geometry is YADE's last, kept alive by the row) and goes; rows with no tracked body go;
+        then a tracked body whose count of real interactions (YADE's, in C++) differs from its
+        rows has them taken from YADE (withBody): new ones become fresh rows, missing ones go.
+        Returns masks of the fresh rows and of rows restored from a save, and the overlaps."""
+        restored = np.zeros(len(self), bool)
+        if self._incomplete:                   # restored from a save: find YADE's objects
+            found = []
+            for k, g in enumerate(self.geoms):
+                if g is None:
+                    pair = (int(self.a[k]), int(self.b[k]))
+                    inter = interactions[pair] if interactions.has(*pair) else None
+                    if inter is None or not inter.isReal:
+                        continue
+                    self.geoms[k], self.physs[k] = inter.geom, inter.phys
+                    restored[k] = True
+                found.append(k)
+            self._keep_rows(np.array(found, np.int64))
+            restored = restored[found]
+            self._incomplete = False
+        delta = np.fromiter([g.penetrationDepth for g in self.geoms], float, len(self))
+        keep = (delta >= 0.0) & (mask[self.a] | mask[self.b])
+        if self._erased:
+            gone = np.fromiter(self._erased, np.int64, len(self._erased))
+            keep &= ~(np.isin(self.a, gone) | np.isin(self.b, gone))
+        if not keep.all():
+            rows = np.flatnonzero(keep)
+            self._keep_rows(rows)
+            delta, restored = delta[rows], restored[rows]
+        have = np.bincount(np.concatenate((self.a, self.b)), minlength=len(mask))
+        changed = np.flatnonzero(mask & (have != np.asarray(counts(), np.int64)))
+        fresh = np.zeros(len(self), bool)
+        if len(changed):
+            kept, new = self._rescan(interactions, bodies, changed, now)
+            if kept is not None:
+                delta, restored = delta[kept], restored[kept]
+            if new:
+                added = np.fromiter([inter.geom.penetrationDepth for inter in new], float,
+                                    len(new))
+                fresh = np.concatenate((np.zeros(len(delta), bool), np.ones(len(new), bool)))
+                delta = np.concatenate((delta, added))
+                restored = np.concatenate((restored, np.zeros(len(new), bool)))
+        return fresh, restored, delta
+
+    def _rescan(self, interactions, bodies, changed, now):
+        """Rows of the bodies `changed` from YADE's own lists: rows not in them go, interactions
+        not in the rows are appended as fresh rows. Returns the indices of the rows kept (None:
+        all) and the new interactions."""
+        current = {}
+        for bid in changed.tolist():
+            for inter in interactions.withBody(bid):
+                current[(inter.id1, inter.id2)] = inter
+        touched = np.isin(self.a, changed) | np.isin(self.b, changed)
+        known = set(zip(self.a[touched].tolist(), self.b[touched].tolist()))
+        stale = [k for k, key in zip(np.flatnonzero(touched).tolist(),
+                                     zip(self.a[touched].tolist(), self.b[touched].tolist()))
+                 if key not in current]
+        kept = None
+        if stale:
+            keep = np.ones(len(self), bool)
+            keep[stale] = False
+            kept = np.flatnonzero(keep)
+            self._keep_rows(kept)
+        new = [inter for key, inter in current.items() if key not in known]
+        if new:
+            a = np.array([i.id1 for i in new], np.int64)
+            b = np.array([i.id2 for i in new], np.int64)
+            data = np.zeros((len(FIELDS), len(new)))
+            data[_TIME_BEFORE] = data[_TIME_READ] = now
+            for k, (ia, ib) in enumerate(zip(a.tolist(), b.tolist())):
+                ka = self.stiffness[bodies[ia].material.id]
+                kb = self.stiffness[bodies[ib].material.id]
+                data[_SHARE_A, k] = float(model.energy_partition(ka, kb))
+                data[_SHARE_B, k] = float(model.energy_partition(kb, ka))
+            self._set_rows(np.concatenate((self.a, a)), np.concatenate((self.b, b)),
+                           np.concatenate((self.data, data), axis=1),
+                           self.geoms + [i.geom for i in new], self.physs + [i.phys for i in new])
+        return kept, new
+
+    def _keep_rows(self, rows):
+        """Only the rows `rows` (indices, in order) stay."""
+        self._set_rows(self.a[rows], self.b[rows], self.data[:, rows],
+                       [self.geoms[k] for k in rows.tolist()],
+                       [self.physs[k] for k in rows.tolist()])
 
     def _read_each(self, real, id1, id2, bodies, tracked, zeroed, now, interval, asleep):
         """The same read contact by contact on Python scalars: for a few contacts (laboratory
@@ -272,7 +353,18 @@ class ContactReader:
                 continue
             pair = (a, b) if a < b else (b, a)
             j = index.get((a, b))
-            update = True
+            update, delta = True, None
+            if j is not None:
+                geom = old_geoms[j]
+                if geom is None:                              # restored from a save
+                    row, geom, phys = old_rows[j], inter.geom, inter.phys
+                else:
+                    delta = geom.penetrationDepth
+                    if delta < 0.0:       # the law erased it after the last read, YADE made it anew
+                        j, delta = None, None
+                    else:
+                        row, phys = old_rows[j], old_physs[j]
+                        update = not (asleep and pair in asleep)   # a slack zeroed pair: no work
             if j is None:
                 geom, phys = inter.geom, inter.phys
                 ka = self.stiffness[bodies[a].material.id]
@@ -285,15 +377,9 @@ class ContactReader:
                     if cs > 0.0:
                         row[SD] = phys.usTotal.norm()
                         row[SF] = phys.shearForce.norm()
-            else:
-                row = old_rows[j]
-                geom, phys = old_geoms[j], old_physs[j]
-                if geom is None:                              # restored from a save
-                    geom, phys = inter.geom, inter.phys
-                elif asleep and pair in asleep:
-                    update = False                            # a slack zeroed pair: no work
             if update:
-                delta = geom.penetrationDepth
+                if delta is None:
+                    delta = geom.penetrationDepth
                 force = phys.normalForce.norm()
                 d0 = row[OV]
                 work = None
@@ -352,49 +438,11 @@ class ContactReader:
                     if share > found.get(b, (0.0,))[0]:
                         found[b] = (share, k, -1.0, a)
         self._set_rows(np.array(a_list, np.int64), np.array(b_list, np.int64), None, geoms,
-                       physs, codes=False, rows=rows)
+                       physs, rows=rows)
         self._by_body = by_body
         inherited.clear()                 # read now or gone
+        self._erased.clear()
         return Loading(energy, StrongestContacts(found, geoms), grew)
-
-    def _match(self, real, a, b, bodies, now):
-        """Lay the rows out as this read's contacts: known ones keep their numbers, new ones get
-        fresh rows. Returns masks of the fresh rows and of rows restored from a save."""
-        code = pair_codes(a, b)
-        n = len(code)
-        found = np.ones(n, bool)
-        if self.code is None:
-            self.code = pair_codes(self.a, self.b)
-        if not np.array_equal(code, self.code):
-            slot = np.full(n, -1)
-            if len(self.code):
-                order = np.argsort(self.code, kind="stable")
-                pos = np.minimum(np.searchsorted(self.code[order], code), len(order) - 1)
-                found = self.code[order][pos] == code
-                slot[found] = order[pos][found]
-            else:
-                found[:] = False
-            data = np.zeros((len(FIELDS), n))
-            data[:, found] = self.data[:, slot[found]]
-            new = np.flatnonzero(~found)
-            data[_TIME_BEFORE, new] = data[_TIME_READ, new] = now
-            for k in new.tolist():
-                ka = self.stiffness[bodies[int(a[k])].material.id]
-                kb = self.stiffness[bodies[int(b[k])].material.id]
-                data[_SHARE_A, k] = float(model.energy_partition(ka, kb))
-                data[_SHARE_B, k] = float(model.energy_partition(kb, ka))
-            old_geoms, old_physs = self.geoms, self.physs
-            slots = slot.tolist()
-            self._set_rows(a, b, data, [old_geoms[s] if s >= 0 else None for s in slots],
-                           [old_physs[s] if s >= 0 else None for s in slots])
-        fresh = ~found
-        restored = np.zeros(n, bool)
-        if self._incomplete:                   # fresh rows, or restored from a save
-            for k in [k for k, g in enumerate(self.geoms) if g is None]:
-                self.geoms[k], self.physs[k] = real[k].geom, real[k].phys
-                restored[k] = found[k]
-            self._incomplete = False
-        return fresh, restored
 
     def _start_here(self, rows, delta, force, us, fs):
         """The fresh `rows` of inherited pairs count work from the present state on, not from
@@ -554,6 +602,11 @@ class ContactReader:
         """Count a body's energy from now on: its offsets become its contacts' present work."""
         for row, side in self._rows_of(body):
             self._set_value(row, _OFFSET_B if side else _OFFSET_A, self._total(row))
+
+    def erased(self, body):
+        """`body` left the scene (a parent replaced): its rows go at the next read (YADE erased
+        its interactions; the rows' objects would keep their last numbers)."""
+        self._erased.add(body)
 
     def inherit(self, pairs):
         """Pairs (ids) that fresh fragments inherit overlapping: their rows, made at the next

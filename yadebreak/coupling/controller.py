@@ -13,7 +13,7 @@ import warnings
 import numpy as np
 
 from .. import families, reports
-from ._yade import O
+from ._yade import O, utils
 from .contacts import ContactReader
 from .criteria import criterion_for
 from .judging import Judge
@@ -192,7 +192,8 @@ class Controller:
         t0 = time.perf_counter()
         interval = max(1, O.iter - self.last_iter)        # steps since the last read
         loading = self.reader.read(O.interactions, O.bodies, state.tracked, self.zeroing.pairs,
-                                   O.time, interval, self.zeroing.asleep)
+                                   O.time, interval, self.zeroing.asleep,
+                                   utils.numIntrsOfEachBody)
         self.wall_time["read"] += time.perf_counter() - t0
         broken, limits = self.judge.judge(loading, interval, O.iter, self.schedule.mode == "fast")
         if broken:
@@ -244,6 +245,7 @@ class Controller:
                 direction = (np.array([0.0, 0.0, 1.0]) if strongest is None
                              else strongest[2] * np.array(strongest[1]))
                 progeny = self.replacer.replace(bid, t10, direction, dmin)
+                self.reader.erased(bid)
                 event.update(fragments=progeny.ids, family_t10=progeny.family_t10,
                              fragment_speed_excess=progeny.speed_excess)
                 self._adopt(progeny.ids)

@@ -60,7 +60,9 @@ class Judge:
     def judge(self, loading, interval, now_iter, fast):
         """Returns [(id, Ek', strongest contact)] of the bodies that break now, and the steps the
         loaded ones allow before the next read (None unless `fast`)."""
-        candidates = list(self.state.open_events.union(loading.energy))
+        # in id order: the decisions (and the random draws of breakages in one read) do not
+        # depend on the order in which YADE or the reader met the contacts
+        candidates = sorted(self.state.open_events.union(loading.energy))
         if not candidates:
             return [], None
         plan_of = self.plan_each if len(candidates) <= SMALL else self.plan_all

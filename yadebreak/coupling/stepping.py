@@ -148,10 +148,17 @@ def largest_speed():
 
 
 def smallest_rayleigh_time():
-    """Rayleigh time (s) of the smallest sphere in the scene (None if there is none)."""
-    times = [float(placement.rayleigh_time(b.shape.radius, b.material.density, b.material.young,
-                                           b.material.poisson))
-             for b in O.bodies if b is not None and isinstance(b.shape, wrapper.Sphere)]
+    """Rayleigh time (s) of the smallest sphere in the scene (None if there is none): one pass
+    for the smallest radius of each material, then one Rayleigh time per material."""
+    smallest = {}                                  # material id -> (radius, material)
+    sphere = wrapper.Sphere
+    for b in O.bodies:
+        if b is not None and isinstance(b.shape, sphere):
+            r, mat = b.shape.radius, b.material
+            if mat.id not in smallest or r < smallest[mat.id][0]:
+                smallest[mat.id] = (r, mat)
+    times = [float(placement.rayleigh_time(r, mat.density, mat.young, mat.poisson))
+             for r, mat in smallest.values()]
     return min(times) if times else None
 
 
