@@ -5,8 +5,8 @@
 Two scenes of 5.5 mm copper-ore spheres in a steel box, each built for N bodies:
 - dense: a column on a cubic lattice (each sphere touching its neighbours), under gravity, pressed
   by a piston moving down at 0.05 m/s; about three contacts per body;
-- collisional: a loose, jittered cubic lattice (solid fraction 0.155) with random velocities of
-  3 m/s and no gravity; a few percent of the bodies in contact at a time.
+- collisional: a jittered cubic lattice (solid fraction 0.39) with random velocities of 3 m/s and
+  no gravity: a dense granular gas, a few percent of the bodies in contact at a time.
 Each scene runs in plain YADE (no yadebreak), with yadebreak's default (read_period="fast"), and
 with every contact read every step (read_period="every_step"), first with breakage out of reach
 (fracture energies set very high), then, for the collisional scene, with breakage in reach
@@ -31,8 +31,8 @@ from yadebreak.coupling.config import Config  # noqa: E402
 from yadebreak.coupling.stepping import smallest_rayleigh_time  # noqa: E402
 
 RADIUS = 2.75e-3
-#: steps run before the timing (a quarter of it beyond 1e3 bodies): the lattice's first contacts
-#: settle, the first collisions happen
+#: steps run before the timing (dense: a quarter of it beyond 1e3 bodies; collisional: three
+#: times it): the lattice's first contacts settle, the collisions begin
 WARM_UP = 200
 #: the modes compared: attach() options, None for plain YADE
 MODES = {"plain": None, "default": {}, "every step": {"read_period": "every_step"}}
@@ -65,10 +65,10 @@ def build(kind, n, seed=1):
         pitch = 2 * RADIUS * (1 - 2e-4)           # neighbours overlap by 1 um: in contact
         centres, side, height = _lattice(n, pitch, column=4)
     else:
-        pitch = 2 * RADIUS * 1.5                  # solid fraction 0.155
+        pitch = 2 * RADIUS * 1.1                  # solid fraction 0.39
         centres, side, height = _lattice(n, pitch)
-        # jittered by up to 0.24 diameters per axis (no overlap): collisions from the start
-        centres = centres + rng.uniform(-0.48, 0.48, centres.shape) * RADIUS
+        # jittered by up to 0.045 diameters per axis (no overlap): collisions from the start
+        centres = centres + rng.uniform(-0.09, 0.09, centres.shape) * RADIUS
     hi = np.array([side * pitch, side * pitch, height * pitch]) + RADIUS * 0.01
     _box(np.full(3, -RADIUS * (0.01 if kind == "dense" else 1.0)), hi)
     ids = O.bodies.append([utils.sphere(tuple(p), RADIUS, material="ore") for p in centres])
@@ -107,7 +107,8 @@ def prepare(kind, n, mode, breakable=False, speed=None):
         if not breakable:
             for st in brk.bodies.values():
                 st.fracture_energy = 1e30
-    coupling.run_steps(WARM_UP if n <= 1000 else WARM_UP // 4)
+    coupling.run_steps(3 * WARM_UP if kind == "collisional" else
+                       WARM_UP if n <= 1000 else WARM_UP // 4)
     return brk, attach_s
 
 

@@ -184,6 +184,8 @@ def _damage_one(ratio, gamma):
     for _ in range(100):
         d = math.exp(y)
         f = p * y + math.log(2.0 * gamma + 5.0 - 5.0 * d) - math.log(2.0 * gamma) - log_r
+        if abs(f) <= 4e-16 * max(1.0, abs(log_r)):      # a root to round-off: Newton would only
+            break                                      # bounce off the bracket from here
         if f < 0.0:
             lo = y
         else:

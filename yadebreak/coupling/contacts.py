@@ -1,12 +1,17 @@
 """Reading the stressing energy from YADE's interactions (Eqs. 14-16).
 
-ContactReader keeps the real interactions that involve a tracked body as columns of numbers, one
-row per contact in YADE's order, and turns each read into the loading of each body: its counted
-energy Ek' (J), its most energetic contact, and whether any of its contacts still worked. Per
-contact, Python only fetches YADE's numbers (ids, overlap, force: about 0.7 us); the work and the
-sums are numpy over all the contacts at once. The work law of YADE's Hertz-Mindlin contacts is
-HertzMindlinWork. Duck-typed on YADE's interaction container, geometry and physics objects; no
-yade import.
+ContactReader keeps the real interactions that involve a tracked body as rows of numbers, one per
+contact, and turns each read into the loading of each body: its counted energy Ek' (J), its most
+energetic contact, and whether any of its contacts still worked. Two paths read alike
+(tests/test_contact_paths.py):
+- few contacts (laboratory scenes): YADE's list of real interactions, contact by contact on
+  Python scalars;
+- many (process scale): the rows kept, their overlaps and forces fetched from YADE (about 0.5 us
+  per contact) and their work and sums in numpy; new contacts are looked for only around the
+  tracked bodies whose count of real interactions (one C++ call for all the bodies) differs from
+  their rows: no pass over every interaction in Python.
+The work law of YADE's Hertz-Mindlin contacts is HertzMindlinWork. Duck-typed on YADE's
+interaction container, geometry and physics objects; no yade import.
 """
 from __future__ import annotations
 
@@ -17,9 +22,9 @@ import numpy as np
 
 from .. import model
 
-#: up to this many real interactions a read goes contact by contact on Python scalars, beyond
-#: with numpy over all of them: measured, the scalar path costs about 1.1 us per contact, the
-#: numpy one about 0.5 us per contact plus 100 us per read
+#: while the rows are at most this many a read goes contact by contact on Python scalars, beyond
+#: with numpy: measured, the scalar path costs about 1.7 us per contact, the numpy one about
+#: 0.7 us per contact plus 100 us per read
 SMALL = 150
 #: up to this many counted contact sides in a numpy read are summed one by one
 SMALL_SIDES = 48
@@ -176,14 +181,14 @@ class ContactReader:
         self._set_rows(np.empty(0, np.int64), np.empty(0, np.int64),
                        np.empty((len(FIELDS), 0)), [], [])
 
-    def _set_rows(self, a, b, data, geoms, physs, rows=None):
+    def _set_rows(self, a, b, data, geoms, physs, rows=None, incomplete=False):
         self.a, self.b = a, b                         # body ids as YADE orders the pair
         # the numbers: a block FIELDS x contacts, or (after a scalar read, until numpy is needed)
         # one list per contact
         self._data, self._rows = data, rows
         self.geoms, self.physs = geoms, physs          # YADE's objects (None after a restore)
         self._by_body = None                           # see _rows_of
-        self._incomplete = any(g is None for g in geoms)   # rows without YADE's objects yet
+        self._incomplete = incomplete          # rows without YADE's objects yet (a restore)
 
     def __len__(self):
         return len(self.a)
@@ -270,8 +275,9 @@ class ContactReader:
         delta = np.fromiter([g.penetrationDepth for g in self.geoms], float, len(self))
         keep = (delta >= 0.0) & (mask[self.a] | mask[self.b])
         if self._erased:
-            gone = np.fromiter(self._erased, np.int64, len(self._erased))
-            keep &= ~(np.isin(self.a, gone) | np.isin(self.b, gone))
+            gone = np.zeros(len(mask), bool)
+            gone[np.fromiter(self._erased, np.int64, len(self._erased))] = True
+            keep &= ~(gone[self.a] | gone[self.b])
         if not keep.all():
             rows = np.flatnonzero(keep)
             self._keep_rows(rows)
@@ -299,7 +305,9 @@ class ContactReader:
         for bid in changed.tolist():
             for inter in interactions.withBody(bid):
                 current[(inter.id1, inter.id2)] = inter
-        touched = np.isin(self.a, changed) | np.isin(self.b, changed)
+        is_changed = np.zeros(len(bodies), bool)
+        is_changed[changed] = True
+        touched = is_changed[self.a] | is_changed[self.b]
         known = set(zip(self.a[touched].tolist(), self.b[touched].tolist()))
         stale = [k for k, key in zip(np.flatnonzero(touched).tolist(),
                                      zip(self.a[touched].tolist(), self.b[touched].tolist()))
@@ -633,7 +641,8 @@ class ContactReader:
         values = np.array([r[2:] for r in rows], float).reshape(len(rows), len(FIELDS))
         self._set_rows(np.array([r[0] for r in rows], np.int64),
                        np.array([r[1] for r in rows], np.int64), values.T.copy(),
-                       [None] * len(rows), [None] * len(rows))
+                       [None] * len(rows), [None] * len(rows),
+                       incomplete=bool(rows))
         self.inherited = {tuple(pair) for pair in data.get("inherited", ())}
 
 
