@@ -1,6 +1,6 @@
 """Benchmark: the engine's cost at process scale, beside plain YADE (issue 15, item 3).
 
-    /usr/bin/python3 benchmarks/bench_scale.py [--quick] [--sizes 1000,10000,100000]
+    /usr/bin/python3 benchmarks/bench_scale.py [--quick] [--sizes 1000,10000,100000] [--repeats 3]
 
 Two scenes of 5.5 mm copper-ore spheres in a steel box, each built for N bodies:
 - dense: a column on a cubic lattice (each sphere touching its neighbours), under gravity, pressed
@@ -129,17 +129,21 @@ def rate(kind, n, mode, steps, breakable=False, speed=None):
     return 1e6 * elapsed / steps, O.interactions.countReal(), broken, attach_s
 
 
-def per_step(sizes):
-    print("\n1. Cost per step, breakage out of reach (us per step; ratio to plain YADE)")
+def per_step(sizes, repeats):
+    print(f"\n1. Cost per step, breakage out of reach (us per step, the median of {repeats} runs "
+          f"up to 1e4 bodies, the modes in turn; ratio to plain YADE)")
     attach_times = {}
     for kind in ("dense", "collisional"):
         for n in sizes:
             steps = steps_for(n)
-            rates = {}
-            for mode in MODES:
-                rates[mode], contacts, _, attach_s = rate(kind, n, mode, steps)
-                if mode == "default":
-                    attach_times[n] = attach_s
+            runs = {mode: [] for mode in MODES}
+            for _ in range(repeats if n <= 10000 else 1):
+                for mode in MODES:
+                    us, contacts, _, attach_s = rate(kind, n, mode, steps)
+                    runs[mode].append(us)
+                    if mode == "default":
+                        attach_times[n] = attach_s
+            rates = {mode: float(np.median(v)) for mode, v in runs.items()}
             plain = rates["plain"]
             print(f"  {kind:11s} {n:7d} bodies, {contacts:6d} contacts, {steps} steps: plain "
                   f"{plain:9.1f}; " + "; ".join(f"{m} {rates[m]:9.1f} ({rates[m] / plain:.2f}x)"
@@ -194,28 +198,32 @@ def _mill_args(out):
                      checkpoint_every=-1.0, resume=False, stop_after=0.0, out=str(out))
 
 
-def mill(steps=3000):
+def mill(steps=3000, repeats=1):
     """The default mill once settled, run from the same saved state in each mode."""
     import tempfile
     from yadebreak import mill as mill_scene
-    print("\n4. The default ball mill (scripts/ball_mill.py), from the charge settled")
+    print(f"\n4. The default ball mill (scripts/ball_mill.py), from the charge settled (median of "
+          f"{repeats})")
     with tempfile.TemporaryDirectory() as out:
         args = _mill_args(out)
         coupling.forget()
         mill_scene.mill_scene(args, mill_scene._options(args, Path(out)))
         saved = str(Path(out) / "settled.yade.gz")
         coupling.save(saved)
-        rates = {}
-        for mode, options in MODES.items():
-            coupling.forget()
-            O.load(saved)
-            if options != {}:                       # plain YADE, or attached afresh
-                coupling.detach()
-                if options is not None:
-                    coupling.attach({"ore": "limestone"}, seed=1, dmin=args.size / 3, **options)
-            t0 = time.perf_counter()
-            coupling.run_steps(steps)
-            rates[mode] = 1e6 * (time.perf_counter() - t0) / steps
+        runs = {mode: [] for mode in MODES}
+        for _ in range(repeats):
+            for mode, options in MODES.items():
+                coupling.forget()
+                O.load(saved)
+                if options != {}:                       # plain YADE, or attached afresh
+                    coupling.detach()
+                    if options is not None:
+                        coupling.attach({"ore": "limestone"}, seed=1, dmin=args.size / 3,
+                                        **options)
+                t0 = time.perf_counter()
+                coupling.run_steps(steps)
+                runs[mode].append(1e6 * (time.perf_counter() - t0) / steps)
+        rates = {mode: float(np.median(v)) for mode, v in runs.items()}
         plain = rates["plain"]
         print(f"  {len(O.bodies)} bodies, {O.interactions.countReal()} contacts, {steps} steps: "
               f"plain {plain:9.1f}; " + "; ".join(f"{m} {rates[m]:9.1f} ({rates[m] / plain:.2f}x)"
@@ -246,13 +254,15 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="1e3 and 1e4 bodies only")
     parser.add_argument("--sizes", default=None, help="comma-separated body counts")
+    parser.add_argument("--repeats", type=int, default=3,
+                        help="runs of each mode up to 1e4 bodies and on the mill (median)")
     args = parser.parse_args(sys.argv[1:])
     sizes = ([int(float(s)) for s in args.sizes.split(",")] if args.sizes
              else [1000, 10000] if args.quick else [1000, 10000, 100000])
-    attach_times = per_step(sizes)
+    attach_times = per_step(sizes, args.repeats)
     with_breakage(sizes)
     event_cost(sizes)
-    mill()
+    mill(repeats=args.repeats)
     print("\n5. attach() on the dense scene: " + ", ".join(
         f"{n} bodies {t:.2f} s" for n, t in attach_times.items()))
     memory(max(sizes))
