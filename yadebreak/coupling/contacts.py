@@ -188,6 +188,7 @@ class ContactReader:
         self._data, self._rows = data, rows
         self.geoms, self.physs = geoms, physs          # YADE's objects (None after a restore)
         self._by_body = None                           # see _rows_of
+        self._index = None                             # (id1, id2) -> row, from a scalar read
         self._incomplete = incomplete          # rows without YADE's objects yet (a restore)
 
     def __len__(self):
@@ -349,7 +350,10 @@ class ContactReader:
         law = self.law
         first_touch = law.first_touch_factor(interval)
         inherited = self.inherited
-        index = dict(zip(zip(self.a.tolist(), self.b.tolist()), range(len(self.a))))
+        index = self._index
+        if index is None:             # the last read was numpy's
+            index = dict(zip(zip(self.a.tolist(), self.b.tolist()), range(len(self.a))))
+        new_index = {}
         old_rows = self._rows if self._rows is not None else self.data.T.tolist()
         old_geoms, old_physs = self.geoms, self.physs
         a_list, b_list, rows, geoms, physs = [], [], [], [], []
@@ -423,6 +427,7 @@ class ContactReader:
                     row[SD] = us
                     row[SF] = fs
             k = len(rows)
+            new_index[(a, b)] = k
             rows.append(row)
             a_list.append(a)
             b_list.append(b)
@@ -447,7 +452,7 @@ class ContactReader:
                         found[b] = (share, k, -1.0, a)
         self._set_rows(np.array(a_list, np.int64), np.array(b_list, np.int64), None, geoms,
                        physs, rows=rows)
-        self._by_body = by_body
+        self._by_body, self._index = by_body, new_index
         inherited.clear()                 # read now or gone
         self._erased.clear()
         return Loading(energy, StrongestContacts(found, geoms), grew)
