@@ -69,17 +69,12 @@ def test_many_contacts_saved_and_loaded_read_on_as_the_run_that_went_on(scene, t
     from yadebreak import coupling, scenes
     O = scene
 
-    def start():
-        coupling.forget()
-        brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 4, 3, 6.0, seed=3,
-                                            read_period="every_step")
-        while not any(O.interactions.withBody(info["ball"])):
-            coupling.run_steps(50)
-        scenes.hold_release(info)
-        coupling.run_steps(300)
-        return brk
-
-    brk = start()
+    brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 4, 3, 6.0, seed=3,
+                                        read_period="every_step")
+    while not any(O.interactions.withBody(info["ball"])):
+        coupling.run_steps(50)
+    scenes.hold_release(info)
+    coupling.run_steps(300)
     assert len(brk.reader) > brk.reader.small          # the numpy path reads this scene
     coupling.save(tmp_path / "mid.yade.gz")
     coupling.run_steps(400)
