@@ -90,15 +90,16 @@ def build(kind, n, seed=1):
     return ids
 
 
-def prepare(kind, n, mode, breakable=False, speed=None):
-    """Build the scene, attach yadebreak in `mode`, and run it past its first contacts. Returns the
-    controller (None in plain YADE) and the seconds attach() took."""
+def prepare(kind, n, mode, breakable=False, speed=None, **extra):
+    """Build the scene, attach yadebreak in `mode` (with `extra` attach() options), and run it
+    past its first contacts. Returns the controller (None in plain YADE) and the seconds attach()
+    took."""
     ids = build(kind, n)
     if speed is not None:
         for i in ids:
             b = O.bodies[i]
             b.state.vel = b.state.vel * (speed / b.state.vel.norm())
-    options = MODES[mode]
+    options = MODES[mode] if MODES[mode] is None else {**MODES[mode], **extra}
     brk, attach_s = None, 0.0
     if options is not None:
         t0 = time.perf_counter()
@@ -168,8 +169,7 @@ def event_cost(sizes):
     print("\n3. One breakage event (family at t10' = 10 %) in the dense scene: yadebreak's own work")
     for n in sizes:
         for dummies in ("spheres", "ledger"):
-            MODES["default"] = {"dummies": dummies}
-            brk, _ = prepare("dense", n, "default")
+            brk, _ = prepare("dense", n, "default", dummies=dummies)
             mat = brk.material["ore"]
             ratio = -mat.kappa / mat.b_prime * np.log(1 - 10.0 / mat.A)   # Eq. 8 at 10 %
             tracked = sorted(brk.state.tracked)
@@ -184,7 +184,6 @@ def event_cost(sizes):
             print(f"  {n:7d} bodies, dummies as {dummies:7s}: {1e3 * np.median(own):.2f} ms per "
                   f"event (median of 6, {1e3 * min(own):.2f}-{1e3 * max(own):.2f}; "
                   f"{min(sizes_made)}-{max(sizes_made)} spheres made)")
-    MODES["default"] = {}
 
 
 def _mill_args(out):

@@ -26,8 +26,6 @@ from .. import model
 #: with numpy: measured, the scalar path costs about 1.7 us per contact, the numpy one about
 #: 0.7 us per contact plus 100 us per read
 SMALL = 150
-#: up to this many counted contact sides in a numpy read are summed one by one
-SMALL_SIDES = 48
 
 #: the columns of numbers kept per contact (J, m, N, s); saved with the scene in this order.
 #: offset_a, offset_b: the contact's work already counted in an earlier event of body a (b);
@@ -139,9 +137,6 @@ class StrongestContacts:
     def __setitem__(self, body, value):
         self._made[body] = value
 
-    def __contains__(self, body):
-        return body in self._made or body in self._found
-
     def get(self, body, default=None):
         made = self._made.get(body)
         if made is None:
@@ -166,9 +161,10 @@ class Loading:
 
 
 class ContactReader:
-    """The contacts of tracked bodies, read every time the schedule says: one row per contact,
-    in the order YADE lists them at the last read. Each field of FIELDS is an array (a row of
-    one block, so that a new layout gathers all of them at once)."""
+    """The contacts of tracked bodies, read every time the schedule says: one row per contact
+    (in the order YADE listed them after a scalar read; kept, then new ones, after a numpy read).
+    Each field of FIELDS is an array (a row of one block, so that a new layout gathers all of
+    them at once)."""
 
     def __init__(self, stiffness_by_material_id, cs, emin):
         self.stiffness = stiffness_by_material_id     # YADE material id -> Hertz stiffness (Pa)
@@ -309,10 +305,9 @@ class ContactReader:
         is_changed = np.zeros(len(bodies), bool)
         is_changed[changed] = True
         touched = is_changed[self.a] | is_changed[self.b]
-        known = set(zip(self.a[touched].tolist(), self.b[touched].tolist()))
-        stale = [k for k, key in zip(np.flatnonzero(touched).tolist(),
-                                     zip(self.a[touched].tolist(), self.b[touched].tolist()))
-                 if key not in current]
+        keys = list(zip(self.a[touched].tolist(), self.b[touched].tolist()))
+        known = set(keys)
+        stale = [k for k, key in zip(np.flatnonzero(touched).tolist(), keys) if key not in current]
         kept = None
         if stale:
             keep = np.ones(len(self), bool)
@@ -323,17 +318,20 @@ class ContactReader:
         if new:
             a = np.array([i.id1 for i in new], np.int64)
             b = np.array([i.id2 for i in new], np.int64)
-            data = np.zeros((len(FIELDS), len(new)))
-            data[_TIME_BEFORE] = data[_TIME_READ] = now
-            for k, (ia, ib) in enumerate(zip(a.tolist(), b.tolist())):
-                ka = self.stiffness[bodies[ia].material.id]
-                kb = self.stiffness[bodies[ib].material.id]
-                data[_SHARE_A, k] = float(model.energy_partition(ka, kb))
-                data[_SHARE_B, k] = float(model.energy_partition(kb, ka))
+            data = np.array([self._fresh_row(bodies, ia, ib, now)
+                             for ia, ib in zip(a.tolist(), b.tolist())], float).T
             self._set_rows(np.concatenate((self.a, a)), np.concatenate((self.b, b)),
                            np.concatenate((self.data, data), axis=1),
                            self.geoms + [i.geom for i in new], self.physs + [i.phys for i in new])
         return kept, new
+
+    def _fresh_row(self, bodies, a, b, now):
+        """The numbers (FIELDS) of a contact between bodies a and b seen first at `now`: no
+        work yet, Eq. 4's shares."""
+        ka = self.stiffness[bodies[a].material.id]
+        kb = self.stiffness[bodies[b].material.id]
+        return [0.0, 0.0, 0.0, 0.0, 0.0, float(model.energy_partition(ka, kb)),
+                float(model.energy_partition(kb, ka)), 0.0, 0.0, 0.0, 0.0, now, now]
 
     def _keep_rows(self, rows):
         """Only the rows `rows` (indices, in order) stay."""
@@ -379,10 +377,7 @@ class ContactReader:
                         update = not (asleep and pair in asleep)   # a slack zeroed pair: no work
             if j is None:
                 geom, phys = inter.geom, inter.phys
-                ka = self.stiffness[bodies[a].material.id]
-                kb = self.stiffness[bodies[b].material.id]
-                row = [0.0, 0.0, 0.0, 0.0, 0.0, float(model.energy_partition(ka, kb)),
-                       float(model.energy_partition(kb, ka)), 0.0, 0.0, 0.0, 0.0, now, now]
+                row = self._fresh_row(bodies, a, b, now)
                 if inherited and pair in inherited:          # see _start_here
                     row[OV] = row[OVB] = geom.penetrationDepth
                     row[F] = phys.normalForce.norm()
@@ -542,27 +537,9 @@ class ContactReader:
         grew = set(self.a[in_a & worked].tolist())
         grew.update(self.b[in_b & worked].tolist())
         sides = np.flatnonzero(counted)
-        aggregate = self._aggregate_each if len(sides) <= SMALL_SIDES else self._aggregate_all
-        energy, found = aggregate(sides, body, share)
-        return Loading(energy, StrongestContacts(found, self.geoms), grew)
-
-    def _aggregate_each(self, sides, body, share):
-        """Energy and strongest contact per body, side by side (Python scalars)."""
-        energy, found = {}, {}
-        a, b = self.a, self.b
-        for s, bid, value in zip(sides.tolist(), body[sides].tolist(), share[sides].tolist()):
-            energy[bid] = energy.get(bid, 0.0) + value
-            if value > found.get(bid, (0.0,))[0]:
-                row, side = divmod(s, 2)
-                found[bid] = (value, row, -1.0 if side else 1.0, int(a[row] if side else b[row]))
-        return energy, found
-
-    def _aggregate_all(self, sides, body, share):
-        """The same with numpy over all the sides."""
-        found = {}
         if not len(sides):
-            return {}, found
-        ids, first, group = np.unique(body[sides], return_index=True, return_inverse=True)
+            return Loading(grew=grew)
+        ids, group = np.unique(body[sides], return_inverse=True)
         values = share[sides]
         sums = np.bincount(group, weights=values, minlength=len(ids))
         # strongest: the first side of each body with the largest share (a loop's strict >)
@@ -571,14 +548,15 @@ class ContactReader:
         head[0] = True
         head[1:] = group[best][1:] != group[best][:-1]
         heads = best[head]
+        found = {}
         for g, s, value in zip(group[heads].tolist(), sides[heads].tolist(),
                                values[heads].tolist()):
             if value > 0.0:
                 row, side = divmod(s, 2)
                 found[int(ids[g])] = (value, row, -1.0 if side else 1.0,
                                       int(self.a[row] if side else self.b[row]))
-        by_first = np.argsort(first, kind="stable")     # the bodies in the order a loop met them
-        return dict(zip(ids[by_first].tolist(), sums[by_first].tolist())), found
+        return Loading(dict(zip(ids.tolist(), sums.tolist())),
+                       StrongestContacts(found, self.geoms), grew)
 
     # -- one body's contacts -------------------------------------------------------------------
     def _rows_of(self, body):

@@ -48,7 +48,6 @@ class ReadSchedule:
         self.engine_label = engine_label
         self.smallest = smallest              # () -> (radius, id) or None
         self.scanned = None                   # "fast": largest speed at the last scan (m/s)
-        self.speed_max = None                 # "fast": the speed used at the last read (m/s)
         self.reads_since_scan = 0
         self._auto_key = None
         self._load_key = None
@@ -93,14 +92,14 @@ class ReadSchedule:
             if self.reads_since_scan >= SCAN_EVERY or self.scanned is None:
                 self.reads_since_scan = 0
                 self.scanned = largest_speed()
-            self.speed_max = max(self.scanned, most_energetic_speed())
+            speed = max(self.scanned, most_energetic_speed())
             radius, bid = smallest
             if self._load_key != smallest:
                 mat = O.bodies[bid].material
                 self._load_key = smallest
                 self._load_time_1 = float(placement.hertz_loading_time(
                     radius, mat.density, mat.young, mat.poisson, 1.0))   # at 1 m/s; ~ v^-1/5
-            load_time = self._load_time_1 * max(2.0 * self.speed_max, 1e-6) ** -0.2
+            load_time = self._load_time_1 * max(2.0 * speed, 1e-6) ** -0.2
             k = min(FAST_MAX_PERIOD, int(self.options.fast_fraction * load_time / O.dt))
         if limits:
             k = min(k, int(min(limits)))
