@@ -102,3 +102,19 @@ def test_single_impact_outputs_are_documented(tmp_path):
     assert dotted(summary) - documented("`single_impact.py`") == set()
     missing, kinds = _undocumented_event_fields(sorted(out.glob("events_*.jsonl")))
     assert missing == set() and {"breakage", "damage"} <= kinds
+
+
+@pytest.mark.yade
+def test_agglomerate_impact_outputs_are_documented(tmp_path):
+    out = tmp_path / "agglomerate"
+    summary = _run("agglomerate_impact", out, "--particles", "60", "--duration", "6e-5",
+                   "--vtk-interval", "3e-5")
+    assert dotted(summary) - documented("`agglomerate_impact.py`") == set()
+    arrays = {a.get("Name") for a in ET.parse(out / "paraview" / "spheres_0001.vtp").getroot()
+              .iter("DataArray")} - {None, "connectivity", "offsets"}
+    assert {"damage_ratio", "fragment"} <= arrays
+    assert arrays - documented("ParaView series") == set()
+    doc = DOC.read_text()
+    for name in ("timeseries.csv", "bonds_broken.csv"):
+        header = (out / name).read_text().splitlines()[0].split(",")
+        assert all(f"`{field}`" in doc for field in header), name

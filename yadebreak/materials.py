@@ -250,7 +250,11 @@ _CONTACT = [
     ("rolling_friction", 0.0, True, 10.0, True, "-", 1.0),
     ("restitution", 0.0, False, 1.0, True, "-", 1.0),
 ]
-_TOP_KEYS = {"name", "description", "breakable", "contact_like", "elastic", "breakage", "contact"}
+_TOP_KEYS = {"name", "description", "kind", "breakable", "contact_like", "elastic", "breakage",
+             "contact"}
+#: the kinds of material file: "replacement" (this module's; the default when `kind` is absent)
+#: and "bonded_agglomerate" (spheres and binder, read by yadebreak.bonds)
+KINDS = ("replacement", "bonded_agglomerate")
 
 
 def _range_text(lo, lo_inc, hi, hi_inc):
@@ -304,6 +308,10 @@ def _read_table(doc, key, where, problems, required=True):
 
 def _parse(doc, source):
     problems = []
+    if doc.get("kind", "replacement") != "replacement":
+        raise MaterialError(source, [f"kind = {doc.get('kind')!r}: a bonded-agglomerate material, "
+                                     "read by yadebreak.bonds.load_agglomerate_material (this "
+                                     "reader takes kind = \"replacement\")"])
     _check_keys(doc, _TOP_KEYS, "(top level)", problems)
     name = doc.get("name", Path(source).stem)
     if not isinstance(name, str) or not name:
@@ -428,10 +436,21 @@ def material_search_path():
     return [*listed, Path.cwd() / "materials", MATERIALS_DIR]
 
 
-def available_materials(directory=None):
-    """Names of the material files in `directory`, or in every folder of the search path."""
+def available_materials(directory=None, kind="replacement"):
+    """Names of the material files of `kind` (one of KINDS; None: all) in `directory`, or in
+    every folder of the search path."""
     folders = [Path(directory)] if directory is not None else material_search_path()
-    return sorted({p.stem for folder in folders for p in folder.glob("*.toml")})
+    return sorted({p.stem for folder in folders for p in folder.glob("*.toml")
+                   if kind is None or _kind_of(p) == kind})
+
+
+def _kind_of(path):
+    """The `kind` of a material file (files that do not parse count as "replacement", whose
+    reader reports their problems)."""
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8")).get("kind", "replacement")
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return "replacement"
 
 
 def _find(name):

@@ -62,9 +62,10 @@ class ParaviewSeries:
     resume=True continues a series that a checkpointed run left: frames after the present
     simulated time are dropped, later ones appended. wall_patch: (centre (m, 3), half side (m))
     of the walls' square patches (walls are infinite planes); default: around yadebreak's spheres
-    at the first frame."""
+    at the first frame. sphere_arrays: callable(ids) -> [(name, values, VTK type)], the spheres'
+    own arrays in place of the controller's (the bonded agglomerate: damage ratio, fragment)."""
 
-    def __init__(self, folder, brk, interval, resume=False, wall_patch=None):
+    def __init__(self, folder, brk, interval, resume=False, wall_patch=None, sphere_arrays=None):
         if not interval > 0:
             raise ValueError(f"ParaView frame interval {interval!r}: accepted > 0 s")
         self.folder = Path(folder)
@@ -72,6 +73,7 @@ class ParaviewSeries:
         self.brk = brk
         self.interval = float(interval)
         self._wall_patch = wall_patch     # (centre, half side), or None until the first frame
+        self._sphere_arrays = sphere_arrays
         self._surfaces = None             # ((points, polygons, ids), file) last written
         self.frames = []                  # (time, spheres file, surfaces file)
         if resume:
@@ -119,13 +121,16 @@ class ParaviewSeries:
                 vel.append(tuple(b.state.vel))
                 radius.append(b.shape.radius)
         ids = np.array(ids, dtype=np.int64)
-        columns = self._body_columns(ids)
         arrays = [("id", ids, "Int64"), ("radius", np.array(radius, float), "Float64"),
-                  ("velocity", np.array(vel, float).reshape(-1, 3), "Float64"),
-                  ("fracture_energy", columns["fracture_energy"], "Float64"),
-                  ("damage", columns["damage"], "Float64"),
-                  ("class", columns["class"], "Int32"),
-                  ("generation", columns["generation"], "Int32")]
+                  ("velocity", np.array(vel, float).reshape(-1, 3), "Float64")]
+        if self._sphere_arrays is not None:
+            arrays += self._sphere_arrays(ids)
+            return _polydata(np.array(pos, float).reshape(-1, 3), arrays, "PointData")
+        columns = self._body_columns(ids)
+        arrays += [("fracture_energy", columns["fracture_energy"], "Float64"),
+                   ("damage", columns["damage"], "Float64"),
+                   ("class", columns["class"], "Int32"),
+                   ("generation", columns["generation"], "Int32")]
         return _polydata(np.array(pos, float).reshape(-1, 3), arrays, "PointData")
 
     def _body_columns(self, ids):

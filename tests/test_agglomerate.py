@@ -1,0 +1,200 @@
+"""The bonded agglomerate in YADE (issue 17): the single-bond tension test that calibrates E_B, a
+bonded cantilever against Timoshenko's deflection, and a small agglomerate's impact against the
+document's findings (the 4,104-sphere case: benchmarks/bench_agglomerate.py)."""
+import argparse
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.yade
+
+
+def _two_spheres(radius, distance, binder_changes, seed=1):
+    """Two glass spheres `distance` apart along x bonded by one beam; sphere 0 fixed."""
+    from yade import O, utils
+    from yadebreak import bonds
+    from yadebreak.coupling import bonded
+    mat = bonds.load_agglomerate_material("glass_epoxy")
+    mat = mat.with_binder(**binder_changes)
+    sphere_mat = O.materials.append(__import__("yade").wrapper.FrictMat(
+        young=mat.spheres.young_modulus, poisson=mat.spheres.poisson_ratio,
+        density=mat.spheres.density))
+    ids = np.array([O.bodies.append(utils.sphere((0, 0, 0), radius, material=sphere_mat,
+                                                 fixed=True)),
+                    O.bodies.append(utils.sphere((distance, 0, 0), radius, material=sphere_mat))])
+    O.engines = bonded.bonded_engines(mat.spheres, gravity=0.0)
+    watch, scale = bonded.attach_bonds(ids, np.array([[0, 1]]), np.array([distance]),
+                                       np.array([radius, radius]), mat.binder,
+                                       np.random.default_rng(seed))
+    O.dt = 0.1 * scale
+    return mat, ids, watch
+
+
+def test_single_bond_tension_gives_E_B_and_breaks_at_its_strength(scene):
+    """The document's calibration: a bond 12.5 mm long of radius 0.67 mm pulled at 0.03 m/s.
+    The stress-strain slope is E_B; the bond breaks in tension within one step of reaching its
+    own (drawn) tensile strength."""
+    from yade import O
+    from yadebreak import bonds
+    length, radius = 12.5e-3, 1e-3
+    mat, ids, watch = _two_spheres(radius, length, {"radius_multiplier": 0.67})
+    area = math.pi * (0.67e-3) ** 2
+    b = O.bodies[int(ids[1])]
+    b.state.blockedDOFs = "xyzXYZ"
+    b.state.vel = (0.03, 0, 0)
+    phys = watch.net.physs[0]
+    strain, stress = [], []
+    while watch.broken_count() == 0 and O.iter < 200000:
+        O.step()
+        if watch.broken_count() == 0:
+            strain.append((O.bodies[int(ids[1])].state.pos[0] - length) / length)
+            stress.append(-phys.normalForce[0] / area)        # force on sphere 0 pulls it +x
+    strain, stress = np.array(strain), np.array(stress)
+    slope = np.polyfit(strain, stress, 1)[0]
+    assert slope == pytest.approx(mat.binder.young_modulus, rel=1e-6)
+    strength = watch.net.strengths[0][0]
+    step_increment = mat.binder.young_modulus * 0.03 * O.dt / length
+    assert watch.mode[0] == bonds.TENSION
+    assert stress[-1] < strength <= stress[-1] + 2 * step_increment
+    assert not O.interactions[int(ids[0]), int(ids[1])].isReal    # the bond's interaction went
+
+
+def test_bonded_cantilever_deflects_as_timoshenko(scene):
+    """Sphere 0 clamped, a transverse load P on sphere 1: at rest (dynamic relaxation) the tip's
+    deflection is P L^3 / (3 E I) (1 + Phi / 4), its rotation P L^2 / (2 E I), and the larger end
+    moment (at the clamp) P L."""
+    from yade import O
+    from yadebreak import bonds
+    from yadebreak.coupling import bonded
+    length, radius = 2e-3, 0.8e-3
+    mat, ids, watch = _two_spheres(radius, length, {"radius_multiplier": 0.5,
+                                                    "tensile_strength": 1e5,
+                                                    "shear_strength": 1e5,
+                                                    "compressive_strength": 1e6})
+    newton = next(e for e in O.engines if e.label == "newton")
+    newton.damping = 0.3                       # YADE's non-viscous damping: relaxes to rest
+    load = 1e-3                                 # N
+    O.forces.setPermF(int(ids[1]), (0, load, 0))
+    O.run(60000, True)
+    rb = 0.5 * radius
+    _, inertia, _ = bonds.section(rb)
+    e = mat.binder.young_modulus
+    phi = bonds.timoshenko_phi(rb, length, mat.binder.poisson_ratio)
+    tip = O.bodies[int(ids[1])].state
+    assert tip.pos[1] == pytest.approx(load * length**3 / (3 * e * inertia) * (1 + phi / 4),
+                                       rel=2e-3)
+    assert tip.ori.toRotationVector()[2] == pytest.approx(load * length**2 / (2 * e * inertia),
+                                                          rel=2e-3)
+    moment = bonded._end_moment(watch.net.geoms[0], watch.net.physs[0],
+                                watch.net.lever_a[0], watch.net.lever_b[0])
+    assert moment == pytest.approx(load * length, rel=2e-3)
+    assert watch.broken_count() == 0
+
+
+def _args(out, **changes):
+    values = dict(material="glass_epoxy", particles=250, speed=4.0, duration=2.5e-4,
+                  radius_multiplier=0.0, time_step_fraction=0.2, check_period=1,
+                  sample_interval=5e-6, vtk_interval=1e-4, seed=3, out=str(out))
+    values.update(changes)
+    return argparse.Namespace(**values)
+
+
+def test_small_agglomerate_breaks_as_the_document_reports(scene, tmp_path):
+    """A 250-sphere agglomerate (same sizes and packing density) at 4 m/s: bonds fail in tension
+    far more than in shear and never in compression; the damage stays near the plane (no
+    diametral fracture: one fragment keeps most of the mass); the time series, the log of
+    broken bonds and the summary agree; broken bonds' spheres that touch again do so by
+    Hertz-Mindlin, never by a bond."""
+    from yade import O
+    from yadebreak import agglomerate, bonds
+    summary = agglomerate.run(_args(tmp_path), quiet=True)
+    assert summary["end_reason"] == "finished"
+    assert summary["particles"] == 250
+    assert summary["bonds_broken_tension"] > 20
+    assert summary["bonds_broken_tension"] > 5 * summary["bonds_broken_shear"]
+    assert summary["bonds_broken_compression"] == 0
+    found = summary["findings"]
+    assert found["upper_half_damaged"] < 0.5 * found["damaged_fraction"]
+    assert summary["fragments"]["largest_mass_fraction"] > 0.6
+    assert summary["porosity"] == pytest.approx(
+        1 - agglomerate.solid_fraction_of_document(
+            bonds.load_agglomerate_material("glass_epoxy").spheres), abs=0.01)
+    # the log, the series and the summary tell the same story
+    with open(tmp_path / "bonds_broken.csv") as f:
+        log = list(csv.DictReader(f))
+    broken = summary["bonds_broken_tension"] + summary["bonds_broken_shear"]
+    assert len(log) == broken
+    with open(tmp_path / "timeseries.csv") as f:
+        series = list(csv.DictReader(f))
+    last = series[-1]
+    assert int(last["broken_tension"]) == summary["bonds_broken_tension"]
+    assert float(last["damage_ratio"]) == pytest.approx(summary["damage_ratio"], rel=1e-12)
+    assert float(last["time_ms"]) == pytest.approx(0.25, abs=1e-3)
+    assert all(float(r["time_ms"]) <= 0.25 + 1e-6 for r in log)
+    # broken bonds: no bond physics left; spheres in contact again touch by Hertz-Mindlin
+    watch = agglomerate_watch()
+    touching = 0
+    for row in np.flatnonzero(watch.mode):
+        a, b = int(watch.net.a[row]), int(watch.net.b[row])
+        if O.interactions.has(a, b) and O.interactions[a, b].isReal:
+            assert type(O.interactions[a, b].phys).__name__ == "MindlinPhys"
+            touching += 1
+    assert touching > 0
+    for f in ("summary.json", "agglomerate_impact.png", "damage_section.png",
+              "paraview/spheres.pvd"):
+        assert (tmp_path / f).exists()
+    assert json.loads((tmp_path / "summary.json").read_text())["steps"] == O.iter
+
+
+def agglomerate_watch():
+    from yadebreak.coupling import bonded
+    return bonded._WATCHES[bonded.LABEL]
+
+
+def test_build_and_breakage_are_reproducible_from_the_seed(scene, tmp_path):
+    from yadebreak import agglomerate
+    first = agglomerate.run(_args(tmp_path / "a", particles=120, duration=1e-4), quiet=True)
+    second = agglomerate.run(_args(tmp_path / "b", particles=120, duration=1e-4), quiet=True)
+    assert (tmp_path / "a" / "bonds_broken.csv").read_text() == (
+        tmp_path / "b" / "bonds_broken.csv").read_text()
+    for key in ("bonds_initial", "bonds_broken_tension", "damage_ratio", "porosity"):
+        assert first[key] == second[key]
+    other = agglomerate.run(_args(tmp_path / "c", particles=120, duration=1e-4, seed=4),
+                            quiet=True)
+    assert other["porosity"] != first["porosity"]
+
+
+def test_the_scalar_screen_never_misses_a_bond_near_its_strength(scene, tmp_path):
+    """BondWatch computes exact end moments only where a scalar upper bound reaches 80 % of a
+    strength: mid-impact, the exact stresses of every intact bond give the same counts and the
+    same failing bonds."""
+    from yadebreak import agglomerate, bonds
+    from yadebreak.coupling import bonded
+    from yade import O
+    agglomerate.run(_args(tmp_path, particles=200, duration=2e-5), quiet=True)
+    watch = agglomerate_watch()
+    for _ in range(3000):                                   # on to a step with bonds near failure
+        if watch.above[0] > 2:
+            break
+        O.step()
+    tensile, shear, compressive = watch._stresses()
+    net, alive = watch.net, watch.alive
+    exact = np.array([bonded._end_moment(net.geoms[r], net.physs[r], net.lever_a[r],
+                                         net.lever_b[r]) for r in alive])
+    depth = np.array([net.geoms[r].penetrationDepth for r in alive])
+    axial = -net.stiffness.axial[alive] * (depth - net.unp[alive])
+    t, s, c = bonds.bond_stresses(axial, [net.physs[r].shearForce.norm() for r in alive], exact,
+                                  [net.physs[r].moment_twist.norm() for r in alive],
+                                  net.radius[alive])
+    st, sc = net.strengths[0][alive], net.strengths[2][alive]
+    level = bonded.WATCH_LEVEL
+    assert np.count_nonzero(t >= level * st) > 0          # mid-impact: some bonds near failure
+    np.testing.assert_array_equal(tensile >= level * st, t >= level * st)
+    np.testing.assert_array_equal(compressive >= level * sc, c >= level * sc)
+    near = t >= level * st
+    np.testing.assert_allclose(tensile[near], t[near], rtol=1e-12)
+    assert np.all(tensile >= t - 1e-9 * st)                 # elsewhere an upper bound
+    assert math.isfinite(float(np.max(shear)))

@@ -1,0 +1,306 @@
+"""A bonded agglomerate in YADE: its spheres, its beam bonds on YADE's cohesive law, and the
+failure criterion of Eqs. B7-B8 (docs/bonded.md) evaluated here, since YADE's law breaks bonds on
+force alone.
+
+    scene = agglomerate_scene(material, packing, seed=1)          # after O.reset()
+    watch = scene.watch                                           # a BondWatch, in O.engines
+    O.run(1000, True); watch.broken_count(), watch.damage_ratios()
+
+Each bond is a YADE interaction whose physics is a CohFrictPhys given the beam's stiffnesses of
+Eq. B6 (axial, shear, bending, twist), made stress-free where it is built (`unp`: the sphere gap),
+with adhesions YADE can never reach: YADE integrates the beam, BondWatch breaks it. A broken bond's
+interaction is erased; if the spheres touch again YADE makes a Hertz-Mindlin contact (the only
+physics functor of the scene), with damping and rolling friction. A contact is bonded or not,
+never both.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import bonds, placement
+from ._yade import O, utils, wrapper as _w
+
+#: stresses at or above this fraction of a bond's strength are counted (the document's Fig. 18)
+WATCH_LEVEL = 0.8
+#: the PyRunner's label, and the key of its BondWatch
+LABEL = "bond_watch"
+_WATCHES: dict = {}
+#: an adhesion YADE's cohesive law never reaches (N, N m): bonds break here, not there
+NEVER = 1e30
+
+
+@dataclass
+class AgglomerateScene:
+    """What agglomerate_scene() built: YADE ids and the BondWatch engine."""
+
+    sphere_ids: np.ndarray   # (n,) YADE body id of packing sphere k
+    target_id: int           # the rigid plane
+    watch: "BondWatch"
+    masses: np.ndarray       # (n,) kg
+    time_scale: float        # Eq. B11, s
+    rayleigh_time: float     # of the smallest sphere, s
+    impact_seconds: float = 0.0   # wall time of the run from the first touch (set by the run)
+
+
+def agglomerate_scene(material, packing, seed, speed=4.0, gap=1e-5, gravity=9.81,
+                      time_step_fraction=0.2, check_period=1):
+    """The agglomerate of `packing` (a bonds.Packing, centred at the origin) bonded by
+    `material` (a bonds.AgglomerateMaterial) in the current, empty YADE scene, its lowest point
+    `gap` (m) above a rigid steel plane z = 0 and moving down at `speed` (m/s). Bond strengths
+    are drawn from numpy's Generator seeded by `seed`. O.dt = time_step_fraction x the shorter of
+    the bonds' time scale (Eq. B11) and the smallest sphere's Rayleigh time."""
+    sp, binder = material.spheres, material.binder
+    rng = np.random.default_rng(seed)
+    sphere_mat = O.materials.append(_w.FrictMat(
+        young=sp.young_modulus, poisson=sp.poisson_ratio, density=sp.density,
+        frictionAngle=math.atan(sp.friction), label="spheres"))
+    steel = O.materials.append(_w.FrictMat(young=210e9, poisson=0.3, density=7800,
+                                           frictionAngle=math.atan(sp.friction), label="target"))
+    pos = packing.positions.copy()
+    pos[:, 2] += gap - float((pos[:, 2] - packing.radii).min())     # lowest point `gap` above
+    ids = np.array(O.bodies.append([utils.sphere(tuple(p), float(r), material=sphere_mat)
+                                    for p, r in zip(pos, packing.radii)]))
+    target = O.bodies.append(utils.wall(0.0, axis=2, sense=1, material=steel))
+    masses = np.array([O.bodies[int(i)].state.mass for i in ids])
+    inertia = 0.4 * masses * packing.radii**2
+    for i in ids:
+        O.bodies[int(i)].state.vel = (0.0, 0.0, -speed)
+
+    pairs, lengths = bonds.bond_pairs(pos, packing.radii, binder.contact_radius_multiplier)
+    rayleigh = float(placement.rayleigh_time(packing.radii.min(), sp.density, sp.young_modulus,
+                                             sp.poisson_ratio))
+    O.engines = bonded_engines(sp, gravity)
+    watch, time_scale = attach_bonds(ids, pairs, lengths, packing.radii, binder, rng, target,
+                                     check_period)
+    O.dt = time_step_fraction * min(time_scale, rayleigh)
+    set_rolling_stiffness(inertia.min())
+    return AgglomerateScene(ids, target, watch, masses, time_scale, rayleigh)
+
+
+def bonded_engines(spheres, gravity=9.81):
+    """The scene's engines: Hertz-Mindlin with damping (restitution) and rolling resistance for
+    the non-bonded contacts (the scene's only physics functor: a broken bond's spheres that touch
+    again get it), YADE's cohesive law integrating the bonds' beams, undamped Newton with gravity
+    along -z. The rolling stiffness is set by set_rolling_stiffness once O.dt is known."""
+    return [
+        _w.ForceResetter(),
+        _w.InsertionSortCollider([_w.Bo1_Sphere_Aabb(), _w.Bo1_Wall_Aabb()]),
+        _w.InteractionLoop(
+            # the real levers (centre to contact point) in the shear increment: the beam mapping
+            # of Eq. B6 needs them (YADE by default takes the radii, which gap bonds exceed)
+            [_w.Ig2_Sphere_Sphere_ScGeom6D(avoidGranularRatcheting=False),
+             _w.Ig2_Wall_Sphere_ScGeom()],
+            [_w.Ip2_FrictMat_FrictMat_MindlinPhys(en=spheres.restitution, es=spheres.restitution,
+                                                   eta=spheres.rolling_friction, krot=0.0,
+                                                   label="hertz")],
+            [_w.Law2_ScGeom6D_CohFrictPhys_CohesionMoment(label="beams"),
+             _w.Law2_ScGeom_MindlinPhys_Mindlin(includeMoment=True, label="law")]),
+        _w.NewtonIntegrator(damping=0.0, gravity=(0.0, 0.0, -gravity), label="newton"),
+    ]
+
+
+def set_rolling_stiffness(smallest_inertia):
+    """Rolling resistance (Eq. B10) as YADE's elastic-plastic contact moment, limited at
+    mu_r F_n R: a stiffness (N m/rad) that reaches the limit within a few steps yet keeps the
+    rotation of the smallest sphere (moment of inertia, kg m2) stable: 0.1 I / dt^2."""
+    hertz = next(f for e in O.engines if isinstance(e, _w.InteractionLoop)
+                 for f in e.physDispatcher.functors if f.label == "hertz")
+    hertz.krot = 0.1 * float(smallest_inertia) / O.dt**2
+
+
+def attach_bonds(ids, pairs, lengths, radii, binder, rng, target_id=None, check_period=1):
+    """Bond spheres `ids` (YADE ids; radii in m) at `pairs` (indices into ids, lengths L_B in
+    m) with beams of `binder` (strengths drawn from rng), after O.engines is set, and register
+    the BondWatch (watching from the first touch of target_id; None: from the first step).
+    Returns (watch, the bonds' time scale of Eq. B11 in s)."""
+    network = BondNetwork.build(ids, pairs, lengths, radii, binder, rng)
+    masses = np.array([O.bodies[int(i)].state.mass for i in ids])
+    time_scale = bonds.bond_time_scale(masses, 0.4 * masses * radii**2, pairs,
+                                       network.stiffness, network.lever_a, network.lever_b)
+    watch = BondWatch(network, target_id, check_period=check_period)
+    _WATCHES[LABEL] = watch
+    # updateGlobals=False: YADE would otherwise copy the caller's locals into __main__ each call
+    O.engines = O.engines + [_w.PyRunner(
+        command=f"__import__('yadebreak.coupling.bonded').coupling.bonded.on_step({LABEL!r})",
+        iterPeriod=1, label=LABEL, updateGlobals=False)]
+    return watch, time_scale
+
+
+def on_step(label):
+    """Called by the PyRunner after Newton's step."""
+    watch = _WATCHES.get(label)
+    if watch is None:
+        raise RuntimeError(f"no BondWatch {label!r} in this process: a bonded scene's bonds are "
+                           "watched by the process that built it (saving and loading one is not "
+                           "supported)")
+    watch()
+
+
+@dataclass
+class BondNetwork:
+    """The bonds as built, one row per bond (arrays), and their YADE interactions."""
+
+    n_spheres: int             # spheres of the packing (some may have no bond)
+    a: np.ndarray              # (m,) YADE id of the first sphere
+    b: np.ndarray              # (m,) YADE id of the second
+    pairs: np.ndarray          # (m, 2) packing indices
+    radius: np.ndarray         # R_B, m (Eq. B2)
+    length: np.ndarray         # L_B, m (Eq. B1)
+    lever_a: np.ndarray        # sphere a's centre to the contact point, m
+    lever_b: np.ndarray
+    stiffness: bonds.BeamStiffness
+    unp: np.ndarray            # YADE's overlap at bonding, m: the beam is stress-free there
+    strengths: tuple           # (tensile, shear, compressive), (m,) each, Pa
+    geoms: list                # YADE ScGeom6D of each bond (valid while intact)
+    physs: list                # YADE CohFrictPhys of each bond
+
+    @classmethod
+    def build(cls, ids, pairs, lengths, radii, binder, rng):
+        """Create the bond interactions in YADE (after O.engines is set) and their beams."""
+        radius = bonds.bond_radius(radii[pairs[:, 0]], radii[pairs[:, 1]],
+                                   binder.radius_multiplier)
+        stiffness = bonds.beam_stiffness(binder.young_modulus, binder.poisson_ratio, radius,
+                                         lengths)
+        m = len(pairs)
+        strengths = tuple(bonds.draw_strengths(mean, binder.strength_cv, m, rng) for mean in
+                          (binder.tensile_strength, binder.shear_strength,
+                           binder.compressive_strength))
+        a, b = ids[pairs[:, 0]], ids[pairs[:, 1]]
+        geoms, physs, unp = [], [], np.empty(m)
+        for k in range(m):
+            inter = utils.createInteraction(int(a[k]), int(b[k]))
+            g = inter.geom
+            unp[k] = g.penetrationDepth
+            phys = _w.CohFrictPhys(
+                kn=float(stiffness.axial[k]), ks=float(stiffness.shear[k]),
+                kr=float(stiffness.bending[k]), ktw=float(stiffness.twist[k]),
+                unp=float(unp[k]), normalAdhesion=NEVER, shearAdhesion=NEVER,
+                momentRotationLaw=True, maxRollPl=-1.0, maxTwistPl=-1.0, fragile=False,
+                cohesionBroken=False, initCohesion=False,
+                tangensOfFrictionAngle=0.0)
+            inter.phys = phys
+            geoms.append(g)
+            physs.append(phys)
+        # ScGeom's contact point sits in the middle of the gap (or overlap)
+        lever_a = radii[pairs[:, 0]] - 0.5 * unp
+        lever_b = radii[pairs[:, 1]] - 0.5 * unp
+        return cls(len(ids), a, b, pairs, radius, lengths, lever_a, lever_b, stiffness, unp,
+                   strengths, geoms, physs)
+
+
+class BondWatch:
+    """Called by a PyRunner every step: from the first touch of the target on, every
+    `check_period` steps, reads every intact bond from YADE, evaluates Eqs. B7-B8 and breaks the
+    bonds that fail (records time and mode, erases the interaction). Before the first touch the
+    agglomerate moves as a rigid body and no bond can change, so nothing is read.
+
+    Cost: about 1 us per intact bond per check (four reads from YADE), plus ~3 us for each bond
+    whose scalar bound reaches WATCH_LEVEL of a strength (its end moments computed exactly)."""
+
+    def __init__(self, network, target_id, check_period=1):
+        self.net = network
+        self.target_id = target_id
+        self.check_period = int(check_period)
+        m = len(network.a)
+        self.mode = np.zeros(m, np.int8)             # bonds.MODES index, 0: intact
+        self.failed_at = np.full(m, np.nan)          # s of simulated time
+        self.alive = np.arange(m)                    # rows of intact bonds
+        self._geoms, self._physs = list(network.geoms), list(network.physs)
+        self.touch_time = None                       # s, the first touch of the target
+        self.above = np.zeros(3, int)                # bonds at >= WATCH_LEVEL: tension, shear,
+        #                                              compression (at the last check)
+        self.checks = 0
+        self.bonds_read = 0
+        self.seconds = 0.0                           # wall time spent in check() (cost report)
+        self.on_failure = None                       # callable(rows, modes, time), if set
+
+    # -- the per-step path --------------------------------------------------------------------
+    def __call__(self):
+        if self.touch_time is None:
+            if self.target_id is not None and O.forces.f(self.target_id).norm() == 0.0:
+                return
+            self.touch_time = O.time
+        if (O.iter % self.check_period) == 0:
+            began = time.perf_counter()
+            self.check()
+            self.seconds += time.perf_counter() - began
+
+    def check(self):
+        """Read the intact bonds, count those near their strengths, break those past them."""
+        tensile, shear, compressive = self._stresses()
+        alive = self.alive
+        st, ss, sc = (s[alive] for s in self.net.strengths)
+        self.above = np.array([np.count_nonzero(tensile >= WATCH_LEVEL * st),
+                               np.count_nonzero(shear >= WATCH_LEVEL * ss),
+                               np.count_nonzero(compressive >= WATCH_LEVEL * sc)])
+        modes = bonds.failure_modes(tensile, shear, compressive, (st, ss, sc))
+        failing = np.flatnonzero(modes)
+        self.checks += 1
+        self.bonds_read += len(alive)
+        if len(failing):
+            self._break(failing, modes[failing])
+
+    def _stresses(self):
+        """Eq. B7 for every intact bond: scalar reads bound the end moments from above (|M| +
+        max(d_a, d_b) |F_s|); bonds whose bound reaches WATCH_LEVEL of a strength get the exact
+        end moments."""
+        net, alive, geoms, physs = self.net, self.alive, self._geoms, self._physs
+        n = len(alive)
+        depth = np.fromiter((g.penetrationDepth for g in geoms), float, n)
+        shear = np.fromiter((p.shearForce.norm() for p in physs), float, n)
+        moment = np.fromiter((p.moment_bending.norm() for p in physs), float, n)
+        twist = np.fromiter((p.moment_twist.norm() for p in physs), float, n)
+        axial = -net.stiffness.axial[alive] * (depth - net.unp[alive])     # tension > 0
+        lever_a, lever_b, radius = net.lever_a[alive], net.lever_b[alive], net.radius[alive]
+        bound = moment + np.maximum(lever_a, lever_b) * shear
+        tensile, shear_stress, compressive = bonds.bond_stresses(axial, shear, bound, twist,
+                                                                 radius)
+        st, sc = net.strengths[0][alive], net.strengths[2][alive]
+        near = np.flatnonzero((tensile >= WATCH_LEVEL * st) | (compressive >= WATCH_LEVEL * sc))
+        if len(near):
+            exact = np.array([_end_moment(geoms[k], physs[k], lever_a[k], lever_b[k])
+                              for k in near])
+            t, _, c = bonds.bond_stresses(axial[near], shear[near], exact, twist[near],
+                                          radius[near])
+            tensile[near], compressive[near] = t, c
+        return tensile, shear_stress, compressive
+
+    def _break(self, failing, modes):
+        rows = self.alive[failing]
+        self.mode[rows] = modes
+        self.failed_at[rows] = O.time
+        for r in rows:
+            O.interactions.erase(int(self.net.a[r]), int(self.net.b[r]))
+        keep = np.ones(len(self.alive), bool)
+        keep[failing] = False
+        self.alive = self.alive[keep]
+        self._geoms = [g for g, k in zip(self._geoms, keep) if k]
+        self._physs = [p for p, k in zip(self._physs, keep) if k]
+        if self.on_failure is not None:
+            self.on_failure(rows, modes, O.time)
+
+    # -- what the run reports -----------------------------------------------------------------
+    def broken_count(self, mode=None):
+        """Bonds broken (in `mode`, a bonds.MODES index, or in any)."""
+        return int(np.count_nonzero(self.mode != bonds.INTACT if mode is None
+                                    else self.mode == mode))
+
+    def damage_ratios(self):
+        """Per packing sphere: broken over initial bonds (Eq. B9; NaN for a sphere with none)."""
+        return bonds.damage_ratios(self.net.n_spheres, self.net.pairs, self.mode != 0)
+
+    def fragments(self):
+        """(label per packing sphere, spheres per label) of the surviving bond graph."""
+        return bonds.fragments(self.net.n_spheres, self.net.pairs, self.mode == 0)
+
+
+def _end_moment(geom, phys, lever_a, lever_b):
+    """The larger of the beam's two end bending moments (N m): |M + d_a n x F_s| at sphere a and
+    |M - d_b n x F_s| at sphere b, M the bending moment YADE integrates (Eqs. B12-B13)."""
+    m = phys.moment_bending
+    lever = geom.normal.cross(phys.shearForce)
+    return max((m + lever * lever_a).norm(), (m - lever * lever_b).norm())
