@@ -11,11 +11,13 @@ OUT ?= out
 # is made to work from any folder (a user's own scenes) under /usr/bin/python3 and yade: see
 # LINK_PACKAGE.
 deps:
-	@if ! command -v yade >/dev/null 2>&1 || ! $(PY) -c "import pytest, numpy, scipy, matplotlib; \
-		from yadebreak.yadepath import ensure_yade_importable as ok; assert ok()" >/dev/null 2>&1; then \
+	@if ! command -v yade >/dev/null 2>&1 || ! $(PY) -c "import pytest, numpy, scipy, matplotlib, \
+		dask, distributed; from yadebreak.yadepath import ensure_yade_importable as ok; \
+		assert ok()" >/dev/null 2>&1; then \
 		echo "[yadebreak] installing YADE and Python packages from Debian (a few minutes, once)"; \
 		apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q \
-			yade python3-yade python3-pytest python3-numpy python3-scipy python3-matplotlib; \
+			yade python3-yade python3-pytest python3-numpy python3-scipy python3-matplotlib \
+			python3-dask python3-distributed; \
 	fi
 	@$(PY) -c "$$LINK_PACKAGE" "$(CURDIR)"
 

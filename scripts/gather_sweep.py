@@ -1,5 +1,8 @@
 """Gather the summaries of a bed sweep into one table and the paper's Figs. 20 and 22.
 
+The bed's own report; `python3 -m yadebreak gather TABLE --out DIR` (or the end of `python3 -m
+yadebreak sweep`) writes the generic DIR/sweep.csv, every summary.json flattened.
+
     /usr/bin/python3 scripts/gather_sweep.py [--sweep out/sweep] [--out out/sweep_report]
                                              [--table scripts/bed_sweep.table]
 A partial sweep is gathered as far as it went: runs without summary.json, or that ended in an
@@ -18,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from yadebreak import sweep as sweep_tables  # noqa: E402
 from yadebreak.reports import bounded_errors  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
@@ -32,12 +36,10 @@ args = parser.parse_args()
 
 def read_table(path):
     """The descriptions (output folder names) of a yade-batch table's lines."""
-    rows = [line.split() for line in Path(path).read_text().splitlines()
-            if line.strip() and not line.lstrip().startswith("#")]
-    if not rows or "description" not in rows[0]:
-        raise SystemExit(f"--table {path}: no header line with a 'description' column")
-    k = rows[0].index("description")
-    return [r[k] for r in rows[1:] if len(r) > k]
+    try:
+        return [line.description for line in sweep_tables.read_table(path)]
+    except sweep_tables.SweepError as exc:
+        raise SystemExit(f"--table: {exc}") from None
 
 
 def gather(sweep, expected):

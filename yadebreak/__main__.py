@@ -1,4 +1,5 @@
-"""Command line: `python -m yadebreak demo | families | materials | options` (no YADE needed).
+"""Command line: `python -m yadebreak demo | families | materials | options | sweep | gather`
+(no YADE needed here; a sweep's workers run YADE).
 
 Options are declared as the scripts' are (scriptargs: type, range, unit, default, help); a bad
 value stops with one line naming the option, the value, the range and the unit (exit code 2)."""
@@ -112,7 +113,46 @@ value, the accepted range and the unit. Written by `python3 -m yadebreak options
 """
 
 
-#: each command: (function, help, its options)
+def sweep(args):
+    """Run a yade-batch table's lines as Dask tasks (yadebreak.sweep)."""
+    from . import sweep as sw
+    options = _key_values(args.jobqueue, "--jobqueue")
+    try:
+        status = sw.run_sweep(args.table, args.script, args.out, scheduler=args.scheduler,
+                              retries=args.retries, jobqueue_options=options, jobs=args.jobs,
+                              say=lambda m: print(f"[yadebreak] {m}", flush=True))
+    except sw.SweepError as exc:
+        fail(str(exc))
+    except KeyboardInterrupt:
+        raise SystemExit(130) from None
+    return sw.main_exit_code(status)
+
+
+def gather(args):
+    """sweep.csv from the runs of a table in --out (a yade-batch sweep's out/sweep, say)."""
+    from . import sweep as sw
+    try:
+        path = sw.gather(args.out, sw.read_table(args.table))
+    except sw.SweepError as exc:
+        fail(str(exc))
+    print(f"[yadebreak] wrote {path}")
+
+
+def _key_values(text_value, option):
+    """'cores=1,memory=2GB' as {cores: 1, memory: '2GB'} (numbers as numbers)."""
+    out = {}
+    for item in filter(None, text_value.split(",")):
+        key, sep, value = item.partition("=")
+        if not sep or not key:
+            fail(f"{option} = {text_value!r}: accepted key=value pairs separated by commas")
+        try:
+            out[key] = json.loads(value)
+        except json.JSONDecodeError:
+            out[key] = value
+    return out
+
+
+#: each command: (function, help, its options[, its positional arguments (name, help)])
 COMMANDS = {
     "demo": (demo, "plot breakage probability and t10 curves of a material", [
         text("material", "copper_ore", "a material name or a .toml file"),
@@ -124,22 +164,37 @@ COMMANDS = {
         text("out", "out/families.png", "the plot (PNG)")]),
     "materials": (list_materials, "list the material library", []),
     "options": (print_options, "the engine's options as Markdown (docs/options.md)", []),
+    "sweep": (sweep, "run a yade-batch table's lines as Dask tasks, on this machine or a cluster", [
+        text("out", "out/sweep", "folder of the sweep: <out>/<description>/ per line, "
+             "sweep.json, sweep.csv"),
+        text("scheduler", "local", "local, local:N (N workers), tcp://HOST:PORT (a running "
+             "scheduler), slurm or pbs (dask-jobqueue)"),
+        integer("retries", 1, "further attempts of a failing line in this call", lo=0),
+        integer("jobs", 1, "slurm/pbs: batch jobs to start (each one worker)", lo=1),
+        text("jobqueue", "", "slurm/pbs: the cluster's options as key=value,... (e.g. "
+             "queue=short,walltime=02:00:00,memory=4GB,cores=1)")],
+        [("table", "the yade-batch table"), ("script", "the YADE script each line runs")]),
+    "gather": (gather, "flatten every line's summary.json of a sweep into <out>/sweep.csv", [
+        text("out", "out/sweep", "the folder holding <description>/summary.json per line")],
+        [("table", "the yade-batch table")]),
 }
 
 
 def main(argv=None):
     parser = ScriptParser(prog="python -m yadebreak")
     sub = parser.add_subparsers(dest="command", required=True)
-    for name, (func, what, params) in COMMANDS.items():
+    for name, (func, what, params, *positional) in COMMANDS.items():
         p = sub.add_parser(name, help=what, description=what)
+        for arg, arg_help in (positional[0] if positional else ()):
+            p.add_argument(arg, help=arg_help)
         add_params(p, params + [DEBUG])
         p.set_defaults(func=func, params=params + [DEBUG])
     argv = sys.argv[1:] if argv is None else list(argv)
-    every = [p for _, _, params in COMMANDS.values() for p in params]
+    every = [p for _, _, params, *_ in COMMANDS.values() for p in params]
     args = parser.parse_args(join_negative_values(argv, every))
     read_params(args, args.params)
     try:
-        args.func(args)
+        return args.func(args) or 0
     except MaterialError as exc:
         if args.debug:
             raise

@@ -373,8 +373,10 @@ def script_params(params, description=None, argv=None):
         read_params(values, params)
         description = O.tags["description"] if "description" in O.tags.keys() else None
         if "out" in defaults and values.out == defaults["out"] and description:
-            values.out = str(os.path.join(os.path.dirname(defaults["out"]) or ".", "sweep",
-                                          description))
+            # `python3 -m yadebreak sweep` names the folder of its lines; yade-batch: out/sweep/
+            root = os.environ.get("YADEBREAK_SWEEP_OUT") or os.path.join(
+                os.path.dirname(defaults["out"]) or ".", "sweep")
+            values.out = str(os.path.join(root, description))
         return values
     parser = ScriptParser(description=description)
     add_params(parser, params)
