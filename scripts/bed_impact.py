@@ -31,6 +31,8 @@ args = script_params([
     time_step_option(),
     number("dmin", 0.0, "m", "fragments whose progeny would be finer never break "
            "(0: particle size / 20)", lo=0),
+    number("stiffness_scale", 1.0, "-", "factor on every Young's modulus (a speed knob; the "
+           "paper's is 1)", lo=0, hi=1, lo_open=True),
     number("global_damping", 0.0, "-", "Newton damping of fresh fragments (0: none)", lo=0, hi=1,
            hi_open=True),
     choice("dummies", "ledger", ("ledger", "spheres"), "the unresolved fines: a mass ledger, or "

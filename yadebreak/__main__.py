@@ -1,5 +1,5 @@
-"""Command line: `python -m yadebreak demo | families | materials | options | sweep | gather`
-(no YADE needed here; a sweep's workers run YADE).
+"""Command line: `python -m yadebreak demo | families | materials | options | sweep | gather |
+tradeoff` (no YADE needed here; the workers of a sweep or a trade-off run YADE).
 
 Options are declared as the scripts' are (scriptargs: type, range, unit, default, help); a bad
 value stops with one line naming the option, the value, the range and the unit (exit code 2)."""
@@ -138,6 +138,53 @@ def gather(args):
     print(f"[yadebreak] wrote {path}")
 
 
+TRADEOFF_USAGE = """python -m yadebreak tradeoff SCRIPT [script options] --vary NAME=V1,V2,...
+    [--vary ...] --seeds N --metrics KEY,KEY,... --out DIR [--reference NAME=V,...]
+    [--scheduler SPEC] [--retries N]
+
+Runs SCRIPT over the grid of the varied options x seeds 1..N (the same seeds for every variant),
+one Dask task per run (as `sweep`), reads each run's summary.json and writes DIR/tradeoff.csv,
+tradeoff.md and pareto.png: per variant the wall time, the speed-up against the reference (the
+--reference variant, or the slowest) and each metric's paired difference from it with a 95 %
+interval. NAME is the script's option without its dashes (--vary time-step-fraction=0.02,0.05);
+KEY a dotted summary.json key (results.0.broken_fraction); options of the script not varied
+follow SCRIPT and reach every run."""
+
+
+def tradeoff_command(argv):
+    """`python -m yadebreak tradeoff`: its own parser, as the script's options pass through."""
+    from . import tradeoff as to
+    from .sweep import SweepError
+    parser = ScriptParser(prog="python -m yadebreak tradeoff", usage=TRADEOFF_USAGE,
+                          allow_abbrev=False)
+    parser.add_argument("script", help="the YADE script (takes --seed, --out and the options)")
+    parser.add_argument("--vary", action="append", default=[], help="NAME=V1,V2,... (repeatable)")
+    parser.add_argument("--seeds", default="5", help="seeds 1..N per variant; default 5")
+    parser.add_argument("--metrics", default="", help="dotted summary.json keys, comma-separated")
+    parser.add_argument("--out", default="out/tradeoff", help="output folder")
+    parser.add_argument("--reference", default="", help="NAME=V,... (default: the slowest)")
+    parser.add_argument("--scheduler", default="local", help="as for sweep; default local")
+    parser.add_argument("--retries", default="1", help="as for sweep; default 1")
+    args, script_args = parser.parse_known_args(argv)
+    numbers = {}
+    for name in ("seeds", "retries"):
+        text_value = getattr(args, name)
+        if not text_value.isdigit() or (name == "seeds" and int(text_value) < 1):
+            fail(f"--{name} = {text_value}: must be an integer >= {1 if name == 'seeds' else 0}")
+        numbers[name] = int(text_value)
+    try:
+        varied = to.parse_vary(args.vary)
+        to.run(args.script, script_args, varied, numbers["seeds"],
+               [m.strip() for m in args.metrics.split(",") if m.strip()], args.out,
+               reference_text=args.reference, scheduler=args.scheduler,
+               retries=numbers["retries"], say=lambda m: print(f"[yadebreak] {m}", flush=True))
+    except (to.TradeoffError, SweepError) as exc:
+        fail(str(exc))
+    except KeyboardInterrupt:
+        raise SystemExit(130) from None
+    return 0
+
+
 def _key_values(text_value, option):
     """'cores=1,memory=2GB' as {cores: 1, memory: '2GB'} (numbers as numbers)."""
     out = {}
@@ -181,15 +228,19 @@ COMMANDS = {
 
 
 def main(argv=None):
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["tradeoff"]:
+        return tradeoff_command(argv[1:])
     parser = ScriptParser(prog="python -m yadebreak")
     sub = parser.add_subparsers(dest="command", required=True)
+    sub.add_parser("tradeoff", help="speed against accuracy of a script's options, over seeds "
+                   "(python -m yadebreak tradeoff --help)")     # parsed by tradeoff_command
     for name, (func, what, params, *positional) in COMMANDS.items():
         p = sub.add_parser(name, help=what, description=what)
         for arg, arg_help in (positional[0] if positional else ()):
             p.add_argument(arg, help=arg_help)
         add_params(p, params + [DEBUG])
         p.set_defaults(func=func, params=params + [DEBUG])
-    argv = sys.argv[1:] if argv is None else list(argv)
     every = [p for _, _, params, *_ in COMMANDS.values() for p in params]
     args = parser.parse_args(join_negative_values(argv, every))
     read_params(args, args.params)

@@ -67,6 +67,8 @@ def _options(args, out):
         options["dmin"] = args.dmin
     if args.global_damping > 0:
         options.update(global_damping=args.global_damping, global_damping_time=5e-4)
+    if getattr(args, "stiffness_scale", 1.0) != 1.0:
+        options["stiffness_scale"] = args.stiffness_scale
     return options
 
 

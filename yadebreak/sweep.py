@@ -159,28 +159,45 @@ class SweepStatus:
         os.replace(tmp, self.path)
 
 
-# -- one line: the task a worker runs ---------------------------------------------------------------
-def run_line(script, table, number, description, out, env, cwd, yade="yade"):
-    """Run one table line as yade-batch runs it: `yade -n -jN -x SCRIPT` with YADE_BATCH =
-    TABLE:LINE, the line's !NAME columns in the environment and yade-batch's own columns obeyed
-    (!THREADS or !OMP_NUM_THREADS: N, default 1; !SCRIPT; !EXEC), output into
-    OUT/<description>/log.txt. Returns {exit_code, wall_s, worker,
-    message}: message is the run's error line (the last '[yadebreak] error' line, else its last
-    line) when it failed."""
-    folder = Path(out) / description
-    folder.mkdir(parents=True, exist_ok=True)
-    env = dict(env)
-    # yade-batch's own columns: !THREADS (or !OMP_NUM_THREADS), !SCRIPT, !EXEC
+# -- one run: the task a worker runs -------------------------------------------------------------
+@dataclass(frozen=True)
+class Job:
+    """One run of a sweep: its folder's name, its table line (0 if none), its command and the
+    environment it adds."""
+
+    description: str
+    number: int
+    argv: tuple
+    env: dict = field(default_factory=dict)
+
+
+def table_job(line, table, script, out, yade="yade"):
+    """The Job of a table line, run as yade-batch runs it: `yade -n -jN -x SCRIPT` with
+    YADE_BATCH = TABLE:LINE, the line's !NAME columns in the environment and yade-batch's own
+    columns obeyed (!THREADS or !OMP_NUM_THREADS: N, default 1; !SCRIPT; !EXEC). The yadebreak
+    scripts write into OUT/<description>/ (YADEBREAK_SWEEP_OUT)."""
+    env = dict(line.env)
     threads = env.pop("THREADS", env.pop("OMP_NUM_THREADS", "1"))
-    script = env.pop("SCRIPT", script)
+    script = env.pop("SCRIPT", str(script))
     yade = env.pop("EXEC", yade)
-    environment = {**os.environ, **env, "OMP_NUM_THREADS": str(threads), "DISPLAY": "",
-                   "YADE_BATCH": f"{table}:{number}", OUT_ENV: str(out)}
+    env.update({"OMP_NUM_THREADS": str(threads), "DISPLAY": "",
+                "YADE_BATCH": f"{table}:{line.number}", OUT_ENV: str(out)})
+    return Job(line.description, line.number, (yade, "-n", f"-j{threads}", "-x", str(script)),
+               env)
+
+
+def run_job(argv, folder, env, cwd):
+    """Run one job's command with `env` added, its output into FOLDER/log.txt. Returns
+    {exit_code, wall_s, worker, message}: message is the run's error line (the last '[yadebreak]
+    error' line, else its last line) when it failed."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    environment = {**os.environ, "OMP_NUM_THREADS": "1", **env}
     start = time.time()
     with open(folder / "log.txt", "w") as log:
-        code = subprocess.call([yade, "-n", f"-j{threads}", "-x", str(script)], stdout=log,
-                               stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                               env=environment, cwd=cwd, preexec_fn=_die_with_parent)
+        code = subprocess.call(list(argv), stdout=log, stderr=subprocess.STDOUT,
+                               stdin=subprocess.DEVNULL, env=environment, cwd=cwd,
+                               preexec_fn=_die_with_parent)
     wall = time.time() - start
     message = "" if code == 0 else _error_line(folder / "log.txt")
     return {"exit_code": code, "wall_s": wall, "worker": _worker_name(), "message": message}
@@ -256,42 +273,15 @@ def connect(spec, jobqueue_options=None, jobs=1):
 # -- the sweep ----------------------------------------------------------------------------------
 def run_sweep(table, script, out, scheduler="local", retries=1, jobqueue_options=None, jobs=1,
               say=print, yade="yade"):
-    """Run every line of `table` not done yet in `out`, as Dask tasks; then gather sweep.csv.
-    A failing line is run again up to `retries` more times in this call (not one that exits with
-    code 2, a script refusing the line's values). Ctrl-C stops the sweep:
-    lines done stay done, the others are 'interrupted' and run at the next call. Returns the
-    SweepStatus."""
+    """Run every line of `table` not done yet in `out`, as Dask tasks (run_jobs); then gather
+    sweep.csv. Returns the SweepStatus."""
     table, script, out = Path(table).resolve(), Path(script).resolve(), Path(out).resolve()
     if not script.is_file():
         raise SweepError(f"script {script}: no such file")
-    if retries < 0:
-        raise SweepError(f"--retries = {retries}: accepted >= 0 (extra attempts of a failing "
-                         "line)")
-    lines = {line.description: line for line in read_table(table)}
-    status = SweepStatus(out, table, script, lines.values())
-    todo = status.todo()
-    done_before = len(lines) - len(todo)
-    if not todo:
-        say(f"sweep: all {len(lines)} lines of {table.name} are done in {out}")
-        gather(out, lines.values())
-        return status
-    client, cluster = connect(scheduler, jobqueue_options, jobs)
-    try:
-        say(f"sweep: {len(todo)} of {len(lines)} lines to run ({done_before} done before) on "
-            f"{scheduler}; dashboard {client.dashboard_link}")
-        _run(client, lines, status, todo, script, table, out, retries, say, yade)
-    except KeyboardInterrupt:
-        for description in status.todo():
-            if status.rows[description]["state"] == "submitted":
-                status.update(description, state="interrupted")
-        say(f"sweep: interrupted; {status.count('done')} of {len(lines)} lines done are kept "
-            f"(run the same command again for the others)")
-        raise
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
-    gather(out, lines.values())
+    lines = read_table(table)
+    status = run_jobs([table_job(line, table, script, out, yade) for line in lines], out,
+                      (str(table), str(script)), scheduler, retries, jobqueue_options, jobs, say)
+    gather(out, lines)
     failed = [d for d, row in status.rows.items() if row["state"] == "failed"]
     say(f"sweep: {status.count('done')} of {len(lines)} lines done, {len(failed)} failed; "
         f"wrote {out / 'sweep.csv'}")
@@ -302,17 +292,52 @@ def run_sweep(table, script, out, scheduler="local", retries=1, jobqueue_options
     return status
 
 
-def _run(client, lines, status, todo, script, table, out, retries, say, yade):
+def run_jobs(jobs, out, identity, scheduler="local", retries=1, jobqueue_options=None,
+             cluster_jobs=1, say=print):
+    """Run every Job not done yet in `out` (its sweep.json; `identity`: the (table, script) the
+    folder belongs to) as a Dask task on `scheduler` (see connect), each into
+    OUT/<description>/. A failing job is run again up to `retries` more times in this call (not
+    one that exits with code 2, a script refusing its values). Ctrl-C stops it: jobs done stay
+    done, the others are 'interrupted' and run at the next call. Returns the SweepStatus."""
+    out = Path(out).resolve()
+    if retries < 0:
+        raise SweepError(f"--retries = {retries}: accepted >= 0 (extra attempts of a failing "
+                         "line)")
+    by_name = {job.description: job for job in jobs}
+    status = SweepStatus(out, *identity, jobs)
+    todo = status.todo()
+    if not todo:
+        say(f"sweep: all {len(jobs)} lines are done in {out}")
+        return status
+    client, cluster = connect(scheduler, jobqueue_options, cluster_jobs)
+    try:
+        say(f"sweep: {len(todo)} of {len(jobs)} lines to run ({len(jobs) - len(todo)} done "
+            f"before) on {scheduler}; dashboard {client.dashboard_link}")
+        _run(client, by_name, status, todo, out, retries, say)
+    except KeyboardInterrupt:
+        for description in status.todo():
+            if status.rows[description]["state"] == "submitted":
+                status.update(description, state="interrupted")
+        say(f"sweep: interrupted; {status.count('done')} of {len(jobs)} lines done are kept "
+            f"(run the same command again for the others)")
+        raise
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return status
+
+
+def _run(client, jobs, status, todo, out, retries, say):
     from distributed import as_completed
     cwd = os.getcwd()
 
     def submit(description):
-        line = lines[description]
+        job = jobs[description]
         attempt = status.rows[description]["attempts"] + 1
         status.update(description, state="submitted", attempts=attempt)
-        return client.submit(run_line, str(script), str(table), line.number, description,
-                             str(out), line.env, cwd, yade, pure=False,
-                             key=f"yadebreak-{description}-{attempt}-{time.time_ns()}")
+        return client.submit(run_job, job.argv, str(out / description), job.env, cwd,
+                             pure=False, key=f"yadebreak-{description}-{attempt}-{time.time_ns()}")
 
     futures = as_completed()
     owner, tries = {}, {d: 0 for d in todo}
