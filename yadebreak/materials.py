@@ -439,6 +439,8 @@ def material_search_path():
 def available_materials(directory=None, kind="replacement"):
     """Names of the material files of `kind` (one of KINDS; None: all) in `directory`, or in
     every folder of the search path."""
+    if kind is not None and kind not in KINDS:
+        raise ValueError(f"kind = {kind!r}: accepted {', '.join(KINDS)} or None")
     folders = [Path(directory)] if directory is not None else material_search_path()
     return sorted({p.stem for folder in folders for p in folder.glob("*.toml")
                    if kind is None or _kind_of(p) == kind})
