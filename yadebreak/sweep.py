@@ -30,8 +30,6 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-#: the states of a line in sweep.json
-STATES = ("pending", "submitted", "done", "failed", "interrupted")
 #: the exit code of a yadebreak script refusing its options (never retried)
 USER_ERROR = 2
 #: env var naming the folder a yadebreak script writes its line's outputs in (<it>/<description>)
@@ -113,9 +111,9 @@ def read_table(path):
 
 # -- the status file --------------------------------------------------------------------------------
 class SweepStatus:
-    """DIR/sweep.json: the table, the script and, per line, its state, exit code, wall time
-    (s), worker, attempts and, for a failure, its message. Rewritten whole (atomically) at every
-    change, so a killed sweep leaves it readable."""
+    """DIR/sweep.json: the table, the script and, per line, its state (pending, submitted, done,
+    failed, interrupted), exit code, wall time (s), worker, attempts and, for a failure, its
+    message. Rewritten whole (atomically) at every change, so a killed sweep leaves it readable."""
 
     def __init__(self, out, table, script, lines):
         self.path = Path(out) / "sweep.json"

@@ -210,6 +210,7 @@ class BondWatch:
         self.failed_at = np.full(m, np.nan)          # s of simulated time
         self.alive = np.arange(m)                    # rows of intact bonds
         self._geoms, self._physs = list(network.geoms), list(network.physs)
+        self._intact = _IntactColumns(network, self.alive)
         self.touch_time = None                       # s, the first touch of the target
         self.above = np.zeros(3, int)                # bonds at >= WATCH_LEVEL: tension, shear,
         #                                              compression (at the last check)
@@ -232,8 +233,7 @@ class BondWatch:
     def check(self):
         """Read the intact bonds, count those near their strengths, break those past them."""
         tensile, shear, compressive = self._stresses()
-        alive = self.alive
-        st, ss, sc = (s[alive] for s in self.net.strengths)
+        alive, st, ss, sc = self.alive, *self._intact.strengths
         self.above = np.array([np.count_nonzero(tensile >= WATCH_LEVEL * st),
                                np.count_nonzero(shear >= WATCH_LEVEL * ss),
                                np.count_nonzero(compressive >= WATCH_LEVEL * sc)])
@@ -248,18 +248,18 @@ class BondWatch:
         """Eq. B7 for every intact bond: scalar reads bound the end moments from above (|M| +
         max(d_a, d_b) |F_s|); bonds whose bound reaches WATCH_LEVEL of a strength get the exact
         end moments."""
-        net, alive, geoms, physs = self.net, self.alive, self._geoms, self._physs
-        n = len(alive)
+        col, geoms, physs = self._intact, self._geoms, self._physs
+        n = len(geoms)
         depth = np.fromiter((g.penetrationDepth for g in geoms), float, n)
         shear = np.fromiter((p.shearForce.norm() for p in physs), float, n)
         moment = np.fromiter((p.moment_bending.norm() for p in physs), float, n)
         twist = np.fromiter((p.moment_twist.norm() for p in physs), float, n)
-        axial = -net.stiffness.axial[alive] * (depth - net.unp[alive])     # tension > 0
-        lever_a, lever_b, radius = net.lever_a[alive], net.lever_b[alive], net.radius[alive]
+        axial = -col.axial_stiffness * (depth - col.unp)     # tension > 0
+        lever_a, lever_b, radius = col.lever_a, col.lever_b, col.radius
         bound = moment + np.maximum(lever_a, lever_b) * shear
         tensile, shear_stress, compressive = bonds.bond_stresses(axial, shear, bound, twist,
                                                                  radius)
-        st, sc = net.strengths[0][alive], net.strengths[2][alive]
+        st, _, sc = col.strengths
         near = np.flatnonzero((tensile >= WATCH_LEVEL * st) | (compressive >= WATCH_LEVEL * sc))
         if len(near):
             exact = np.array([_end_moment(geoms[k], physs[k], lever_a[k], lever_b[k])
@@ -280,6 +280,7 @@ class BondWatch:
         self.alive = self.alive[keep]
         self._geoms = [g for g, k in zip(self._geoms, keep) if k]
         self._physs = [p for p, k in zip(self._physs, keep) if k]
+        self._intact = _IntactColumns(self.net, self.alive)
         if self.on_failure is not None:
             self.on_failure(rows, modes, O.time)
 
@@ -296,6 +297,18 @@ class BondWatch:
     def fragments(self):
         """(label per packing sphere, spheres per label) of the surviving bond graph."""
         return bonds.fragments(self.net.n_spheres, self.net.pairs, self.mode == 0)
+
+
+class _IntactColumns:
+    """The network's per-bond constants for the intact bonds, in the order BondWatch reads them:
+    gathered once per breakage, not every step."""
+
+    def __init__(self, net, alive):
+        self.axial_stiffness = net.stiffness.axial[alive]
+        self.unp = net.unp[alive]
+        self.lever_a, self.lever_b = net.lever_a[alive], net.lever_b[alive]
+        self.radius = net.radius[alive]
+        self.strengths = tuple(s[alive] for s in net.strengths)    # tensile, shear, compressive
 
 
 def _end_moment(geom, phys, lever_a, lever_b):
