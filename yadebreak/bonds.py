@@ -241,28 +241,29 @@ def failure_modes(tensile, shear, compressive, strengths):
 
 
 # -- building an agglomerate ----------------------------------------------------------------------
+def diameter_law(spheres):
+    """The spheres' size law (a Spheres): scipy's truncated Gaussian of their mean, sd and
+    bounds (m), frozen; None where sd = 0 (every sphere of the mean size)."""
+    if spheres.diameter_sd == 0:
+        return None
+    sd, mean = spheres.diameter_sd, spheres.diameter_mean
+    return stats.truncnorm((spheres.diameter_min - mean) / sd, (spheres.diameter_max - mean) / sd,
+                           loc=mean, scale=sd)
+
+
 def sphere_diameters(n, spheres, rng):
     """n diameters (m) from the truncated Gaussian of `spheres` (a Spheres), seeded by rng."""
-    if spheres.diameter_sd == 0:
+    law = diameter_law(spheres)
+    if law is None:
         return np.full(n, spheres.diameter_mean)
-    sd = spheres.diameter_sd
-    lo = (spheres.diameter_min - spheres.diameter_mean) / sd
-    hi = (spheres.diameter_max - spheres.diameter_mean) / sd
-    return stats.truncnorm.rvs(lo, hi, loc=spheres.diameter_mean, scale=sd, size=n,
-                               random_state=rng)
+    return law.rvs(size=n, random_state=rng)
 
 
 def mould_diameter_for(n, spheres, solid_fraction):
     """The diameter (m) of the spherical mould that n spheres (mean volume of the truncated
     Gaussian) fill to `solid_fraction` (= 1 - porosity over the mould)."""
-    d = spheres.diameter_mean
-    lo = (spheres.diameter_min - d) / spheres.diameter_sd if spheres.diameter_sd else -1.0
-    hi = (spheres.diameter_max - d) / spheres.diameter_sd if spheres.diameter_sd else 1.0
-    if spheres.diameter_sd:
-        dist = stats.truncnorm(lo, hi, loc=d, scale=spheres.diameter_sd)
-        mean_cube = dist.moment(3)
-    else:
-        mean_cube = d**3
+    law = diameter_law(spheres)
+    mean_cube = spheres.diameter_mean**3 if law is None else law.moment(3)
     solids = n * math.pi / 6.0 * mean_cube
     return (6.0 * solids / (math.pi * solid_fraction)) ** (1.0 / 3.0)
 
