@@ -43,8 +43,10 @@ def bed_rate(rings, layers, mode):
 def _bed_rate_once(rings, layers, mode):
     coupling.forget()
     options = {} if mode in ("plain", "noop") else {"read_period": 1 if mode == "exact" else mode}
+    # the scenes of issue 9's figures: stacked layers, no rolling friction (bench_rolling.py
+    # measures that)
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, rings, layers, 3.05, seed=1,
-                                        **options)
+                                        packing="lattice", rolling=False, **options)
     for st in brk.bodies.values():
         st.fracture_energy = 1e30
     engines = list(O.engines)

@@ -70,7 +70,7 @@ def test_many_contacts_saved_and_loaded_read_on_as_the_run_that_went_on(scene, t
     O = scene
 
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 4, 3, 6.0, seed=3,
-                                        read_period="every_step")
+                                        packing="lattice", read_period="every_step")
     while not any(O.interactions.withBody(info["ball"])):
         coupling.run_steps(50)
     scenes.hold_release(info)

@@ -173,3 +173,20 @@ def test_size_distribution_conserves_mass():
     one = model.size_distribution([model.X_MIN * 5e-3], dummies=([1.0], [5e-3], [10.0]),
                                   beta_params=T1)
     assert one.passing_mass[0] == pytest.approx(1.0)
+
+
+def test_pouring_column_is_loose_and_inside_its_holder():
+    """placement.pouring_column: the requested count, every sphere clear of the others, of the
+    holder's wall and of the anvil, in levels from the bottom up; refuses a holder too narrow."""
+    from yadebreak import placement
+    r, holder = 2.75e-3, 19.5e-3
+    pos = placement.pouring_column(169, r, holder, np.random.default_rng(4))
+    assert pos.shape == (169, 3)
+    gaps = np.linalg.norm(pos[:, None] - pos[None], axis=2)[np.triu_indices(169, 1)] - 2 * r
+    assert gaps.min() > 0.0
+    assert np.linalg.norm(pos[:, :2], axis=1).max() < holder - r
+    assert pos[:, 2].min() > r
+    again = placement.pouring_column(169, r, holder, np.random.default_rng(4))
+    assert np.array_equal(pos, again)                    # from its Generator alone
+    with pytest.raises(ValueError, match="holder radius"):
+        placement.pouring_column(3, r, 1.05 * r, np.random.default_rng(0))

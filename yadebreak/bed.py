@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import coupling, paraview, scenes
+from . import coupling, paraview, poured_bed, scenes
 from .coupling._yade import O
 from .scriptargs import (check_not_finished, check_resume_arguments, mark_finished, mark_started,
                          partial_outputs_on_failure, progress, read_period_value,
@@ -81,13 +81,23 @@ def _start(args, out, energy, say):
         say(f"resumed from {checkpoint} at t = {1e3 * O.time:.3f} ms, iteration {O.iter}")
         return brk, info, loop
     mark_started(out)
-    brk, info = scenes.bed_impact_scene(args.material, args.size, args.rings, args.layers,
-                                        energy, args.seed, **_options(args, out))
+    steel_rolling = getattr(args, "steel_rolling_friction", -1.0)
+    brk, info = scenes.bed_impact_scene(
+        args.material, args.size, args.rings, args.layers, energy, args.seed,
+        packing=None if getattr(args, "packing", "auto") == "auto" else args.packing,
+        rolling=bool(getattr(args, "rolling_friction", True)),
+        steel_rolling_friction=None if steel_rolling < 0 else steel_rolling,
+        bed_cache=_bed_cache(getattr(args, "bed_cache", "")), say=say, **_options(args, out))
     mass = brk.total_mass()
     say(f"{len(info['particles'])} particles of {args.material} ({1e3 * args.size:g} mm), "
         f"{args.layers} layer(s); ball at {info['speed']:.3f} m/s ({energy:g} J, "
         f"{energy / mass:.0f} J per kg of bed); dt {O.dt:.3g} s")
     return brk, info, {"touched": None, "turned": None, "initial_mass": mass, "initial_dt": O.dt}
+
+
+def _bed_cache(given):
+    """--bed-cache: "" the default folder, "off" none."""
+    return None if given == "off" else given
 
 
 def finest_sphere_size():
@@ -129,9 +139,12 @@ def _impact(brk, info, loop, args, out, start, say, frames):
     stop_after = getattr(args, "stop_after", 0.0)
     last_report = last_checkpoint = start
     while True:
+        if loop["touched"] is None:           # the bed's motion before the ball reaches it
+            before_touch = poured_bed.kinetic_energy(info["particles"])
         coupling.run_steps(100 if loop["touched"] is None else 400)
         if loop["touched"] is None and any(O.interactions.withBody(info["ball"])):
             loop["touched"] = O.time
+            loop["bed_kinetic_energy_at_touch"] = before_touch
             scenes.hold_release(info)
         frames()                                  # a frame if one is due (before the checkpoint)
         vz = ball.state.vel[2]
@@ -202,6 +215,10 @@ def _report(brk, info, loop, args, out, energy, runtime, end_reason, end_message
     fates = _fates(brk, info["particles"])
     summary = {
         "material": args.material, "size": args.size, "rings": args.rings, "layers": args.layers,
+        "bed_packing": info["packing"], "bed_height": info["bed_height"],
+        "bed_settling": info["settled"],
+        "bed_kinetic_energy_at_touch": loop.get("bed_kinetic_energy_at_touch"),
+        "rolling_friction": info["rolling_friction"],
         "energy": energy, "ball_speed": info["speed"], "seed": args.seed,
         "particles": len(info["particles"]),
         "initial_mass": initial_mass, "final_mass": brk.total_mass(),

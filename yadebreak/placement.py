@@ -130,3 +130,34 @@ def hertz_loading_time(radius, density, young, poisson, speed):
     e_star = np.asarray(young, dtype=float) / (1.0 - np.asarray(poisson, dtype=float) ** 2)
     speed = np.maximum(np.asarray(speed, dtype=float), 1e-12)
     return 0.5 * 2.868 * (mass ** 2 / (radius * e_star ** 2 * speed)) ** 0.2
+
+
+def pouring_column(count, radius, holder_radius, rng, gap=0.1):
+    """Centres (count x 3, m) of `count` spheres of `radius` (m) spread loosely in a cylinder of
+    `holder_radius` (m) around the z axis, above z = 0, to be poured (settled under gravity):
+    levels of a triangular lattice of spacing 2 r (1 + gap) clipped to the cylinder, each level
+    turned and shifted at random and its points jittered by less than half the gap, so that no
+    two spheres touch and none touches the wall. Levels are 2 r (1 + gap) apart, the lowest
+    r (1 + gap) above z = 0; the lowest `count` points are taken."""
+    if holder_radius <= radius * (1.0 + gap):
+        raise ValueError(f"holder radius {holder_radius} m leaves no room for spheres of radius "
+                         f"{radius} m")
+    spacing = 2.0 * radius * (1.0 + gap)
+    reach = holder_radius - radius * (1.0 + gap)        # centres within: clear of the wall
+    k = int(np.ceil(reach / spacing)) + 2
+    q, r = np.meshgrid(np.arange(-k, k + 1), np.arange(-k, k + 1))
+    lattice = np.column_stack(((q + r / 2.0).ravel(), (r * np.sqrt(3.0) / 2.0).ravel())) * spacing
+    jitter = 0.45 * gap * radius
+    points, z = [], radius * (1.0 + gap)
+    while sum(len(p) for p in points) < count:
+        angle = rng.uniform(0.0, 2.0 * np.pi)
+        turn = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+        xy = lattice @ turn.T + rng.uniform(-0.5, 0.5, 2) * spacing
+        xy = xy[np.linalg.norm(xy, axis=1) <= reach - jitter]
+        xy = xy + rng.uniform(-1.0, 1.0, xy.shape) * jitter / np.sqrt(2.0)
+        if not len(xy):
+            raise ValueError(f"holder radius {holder_radius} m too small to pour spheres of "
+                             f"radius {radius} m")
+        points.append(np.column_stack((xy, np.full(len(xy), z))))
+        z += spacing
+    return np.concatenate(points)[:count]

@@ -1,6 +1,7 @@
 """Scene builders shared by the scripts and tests (coupling layer: imports yade)."""
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -10,22 +11,30 @@ import numpy as np
 # the coupling makes yade importable from Debian's python3 first
 from . import placement
 from .coupling import add_materials, attach, run_steps
+from .coupling.rolling import rolling_engine
+from .coupling.scene_materials import rolling_friction
 from .coupling._yade import O, utils, wrapper as _w
 
 
-def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False):
-    """The standard engine list: collider, Hertz-Mindlin, undamped Newton."""
+def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False, rolling=None):
+    """The standard engine list: collider, Hertz-Mindlin, undamped Newton; with `rolling`
+    ({(material id, id): mu_r}, scene_materials.rolling_friction), the law's contact moment and
+    the part that gives each contact its pair's rolling friction (coupling/rolling.py)."""
     bounds = [_w.Bo1_Sphere_Aabb(), _w.Bo1_Wall_Aabb()]
     geoms = [_w.Ig2_Sphere_Sphere_ScGeom(), _w.Ig2_Wall_Sphere_ScGeom()]
     if facets:
         bounds.append(_w.Bo1_Facet_Aabb())
         geoms.append(_w.Ig2_Facet_Sphere_ScGeom())
-    return [
+    law = _w.Law2_ScGeom_MindlinPhys_Mindlin(includeMoment=rolling is not None, label="law")
+    engines = [
         _w.ForceResetter(),
         _w.InsertionSortCollider(bounds),
-        _w.InteractionLoop(geoms, [ip2], [_w.Law2_ScGeom_MindlinPhys_Mindlin(label="law")]),
+        _w.InteractionLoop(geoms, [ip2], [law]),
         _w.NewtonIntegrator(damping=0.0, gravity=gravity, label="newton"),
     ]
+    if rolling is not None:
+        engines.append(rolling_engine(rolling))
+    return engines
 
 
 def impact_scene(material="copper_ore", size=5.5e-3, speeds=(5.0,), target="steel", seed=0,
@@ -280,41 +289,90 @@ def hex_bed_positions(size, rings, layers=1, gap=0.01):
     return np.array(out)
 
 
+#: the seed stream of the pour, apart from attach()'s (fracture energies, progeny)
+POUR_STREAM = 7
+
+
 def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, energy=3.05,
-                     seed=1, settle_steps=3000, **options):
+                     seed=1, settle_steps=3000, packing=None, rolling=True,
+                     steel_rolling_friction=None, bed_cache="", say=lambda m: None, **options):
     """The paper's unconfined bed impact: a 88 mm steel ball on a bed resting on a steel anvil.
 
-    The ball starts just above the bed with the speed of its drop, v = sqrt(2 E / m). Beds of
-    several layers are held by a cylindrical steel holder, removed when the ball first touches a
-    particle (hold_release() does that). Returns (controller, info dict).
+    The bed: a central particle and `rings` hexagonal rings per layer, `layers` layers. Beds of
+    several layers stand in a cylindrical steel holder, removed when the ball first touches a
+    particle (hold_release() does that). packing "poured" (the default for several layers): as
+    many particles as the lattice holds poured into the holder and settled under gravity
+    (poured_bed.py; the settled bed comes from the cache `bed_cache` when it was settled before,
+    None: no cache); "lattice": the layers stacked in each other's hollows, settled 3000 damped
+    steps. Rolling friction (per contact pair, from the material files; the particle-steel value
+    replaced by `steel_rolling_friction` if given) unless rolling=False. The ball starts just
+    above the bed with the speed of its drop, v = sqrt(2 E / m). Returns (controller, info).
     """
-    O.reset()
-    ip2, mats = add_materials({"ore": material, "steel": "steel"},
-                              stiffness_scale=options.pop("stiffness_scale", 1.0))
-    anvil = O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="steel"))
-    centers = hex_bed_positions(size, rings, layers)
-    particles = [O.bodies.append(utils.sphere(tuple(c), size / 2.0, material="ore"))
-                 for c in centers]
-    holder = []
-    if layers > 1:
-        reach = np.max(np.linalg.norm(centers[:, :2], axis=1)) + size / 2.0 + 0.02 * size
-        height = centers[:, 2].max() + size
-        from yade import geom    # utils.facetCylinder is broken in YADE 2023.02a
-        holder = O.bodies.append(geom.facetCylinder((0, 0, height / 2.0), reach, height,
-                                                    segmentsNumber=24, wallMask=4,
-                                                    material="steel"))
-    O.engines = hertz_engines(ip2, gravity=(0.0, 0.0, -9.81), facets=bool(holder))
-    if layers > 1 and settle_steps:           # settle the stack before anything is tracked
-        scene_dt = O.dt                       # the settling's own step; attach() sets the run's
-        O.dt = 0.2 * utils.PWaveTimeStep()
-        newton = O.engines[-1]
-        newton.damping = 0.4
-        O.run(settle_steps, True)
-        newton.damping = 0.0
-        O.dt = scene_dt
-        for i in particles:
-            O.bodies[i].state.vel = (0, 0, 0)
-            O.bodies[i].state.angVel = (0, 0, 0)
+    from . import poured_bed
+    from .coupling.engine import YADE_DEFAULT_DT
+    packing = packing or ("poured" if layers > 1 else "lattice")
+    if packing not in ("poured", "lattice") or (packing == "poured" and layers < 2):
+        raise ValueError(f"packing {packing!r}: 'lattice', or 'poured' for beds of 2 layers or "
+                         "more")
+    labels = {"ore": material, "steel": "steel"}
+    stiffness_scale = options.pop("stiffness_scale", 1.0)
+    overrides = ({} if steel_rolling_friction is None
+                 else {("ore", "steel"): float(steel_rolling_friction)})
+    lattice = hex_bed_positions(size, rings, layers)
+    holder_radius = float(np.max(np.linalg.norm(lattice[:, :2], axis=1)) + size / 2.0
+                          + 0.02 * size)
+
+    def build():
+        O.reset()
+        ip2, _ = add_materials(labels, stiffness_scale=stiffness_scale)
+        table = rolling_friction(labels, overrides)[0] if rolling else None
+        anvil = O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="steel"))
+        holder = []
+        if layers > 1:             # poured: the loose column's height, cut to the bed after
+            holder = _holder(holder_radius, lattice[:, 2].max() + size if packing == "lattice"
+                             else 2.5 * (lattice[:, 2].max() + size))
+        O.engines = hertz_engines(ip2, gravity=(0.0, 0.0, -9.81), facets=bool(holder),
+                                  rolling=table)
+        if packing == "poured":
+            rng = np.random.default_rng(np.random.SeedSequence([int(seed), POUR_STREAM]))
+            particles, settled = poured_bed.pour(len(lattice), size / 2.0, holder_radius, rng,
+                                                 "ore", say)
+            for i in holder:       # as the lattice's, half a size above the top particle,
+                O.bodies.erase(i)  # but clear of the ball that starts just above the bed
+            ball = BALL_DIAMETER / 2.0
+            clear = ball - math.sqrt(ball ** 2 - holder_radius ** 2)
+            holder = _holder(holder_radius, settled.height + min(size / 2.0, 0.9 * clear))
+        else:
+            particles = [O.bodies.append(utils.sphere(tuple(c), size / 2.0, material="ore"))
+                         for c in lattice]
+            settled = None
+            if layers > 1 and settle_steps:    # settle the stack before anything is tracked
+                O.dt = 0.2 * utils.PWaveTimeStep()
+                newton = O.engines[3]
+                newton.damping = 0.4
+                O.run(settle_steps, True)
+                newton.damping = 0.0
+                for i in particles:
+                    O.bodies[i].state.vel = (0, 0, 0)
+                    O.bodies[i].state.angVel = (0, 0, 0)
+        return {"anvil": anvil, "particles": particles, "holder": list(holder)}, settled
+
+    if packing == "poured":
+        spec = {"size": size, "rings": rings, "layers": layers, "seed": int(seed),
+                "stiffness_scale": stiffness_scale, "rolling": rolling, "overrides":
+                sorted([list(k), v] for k, v in overrides.items()),
+                "holder_radius": holder_radius}
+        mats = {"ore": _material(material), "steel": _material("steel")}
+        folder = None if bed_cache is None else poured_bed.cache_folder(bed_cache)
+        bodies, settled = poured_bed.cached_scene(folder, poured_bed.cache_key(spec, mats), build)
+    else:
+        bodies, settled = build()
+    O.dt = YADE_DEFAULT_DT                    # attach() sets the run's time step
+    mats = {"ore": _material(material)}
+    named = rolling_friction(labels, overrides)[1] if rolling else {}
+    particles = bodies["particles"]
+    centers = (lattice if packing == "lattice"
+               else np.array([tuple(O.bodies[i].state.pos) for i in particles]))
     top = max(O.bodies[i].state.pos[2] for i in particles) + size / 2.0
     ball_radius = BALL_DIAMETER / 2.0
     ball = utils.sphere((0.0, 0.0, top + ball_radius + 0.02 * size), ball_radius, material="steel")
@@ -325,9 +383,26 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
     ball.state.vel = (0.0, 0.0, -speed)
     ball_id = O.bodies.append(ball)
     brk = attach({"ore": material}, seed=seed, **options)
-    info = {"anvil": anvil, "particles": particles, "holder": list(holder), "ball": ball_id,
-            "speed": speed, "centers": centers, "material": mats["ore"]}
+    info = {"anvil": bodies["anvil"], "particles": particles, "holder": bodies["holder"],
+            "ball": ball_id, "speed": speed, "centers": centers, "material": mats["ore"],
+            "packing": packing, "rolling_friction": {
+                "particle_particle": named.get("ore-ore", 0.0),
+                "particle_steel": named.get("ore-steel", named.get("steel-ore", 0.0))},
+            "bed_height": top, "settled": None if settled is None else dataclasses.asdict(settled)}
     return brk, info
+
+
+def _holder(radius, height):
+    """The cylindrical steel holder (24 facets, open at both ends) from z = 0 to `height` (m)."""
+    from yade import geom    # utils.facetCylinder is broken in YADE 2023.02a
+    return list(O.bodies.append(geom.facetCylinder((0, 0, height / 2.0), radius, height,
+                                                   segmentsNumber=24, wallMask=4,
+                                                   material="steel")))
+
+
+def _material(name):
+    from .coupling.scene_materials import _as_material
+    return _as_material(name)
 
 
 def hold_release(info):

@@ -55,6 +55,26 @@ def add_materials(labels, stiffness_scale=1.0):
     return ip2, mats
 
 
+def rolling_friction(labels, overrides=None):
+    """The rolling friction of each pair of the scene's labelled materials (paper Table 6), from
+    their material files, `overrides` {(label, label): mu_r} replacing some. Call after
+    add_materials(labels). Returns ({(YADE material id, id): mu_r}, {"la-lb": mu_r} for reports)."""
+    overrides = {tuple(sorted(k)): float(v) for k, v in (overrides or {}).items()}
+    ids = {m.label: m.id for m in O.materials}
+    mats = {label: _as_material(name) for label, name in labels.items()}
+    by_ids, named = {}, {}
+    for la in labels:
+        for lb in labels:
+            if ids[la] > ids[lb]:
+                continue
+            pair = tuple(sorted((la, lb)))
+            mu = (overrides[pair] if pair in overrides
+                  else mats[la].contact_with(mats[lb]).rolling_friction)
+            by_ids[(ids[la], ids[lb])] = mu
+            named[f"{la}-{lb}"] = mu
+    return by_ids, named
+
+
 @dataclasses.dataclass
 class SceneMaterials:
     """The breakable materials by YADE label, and what the engine needs of every YADE material."""
