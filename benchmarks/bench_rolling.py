@@ -34,7 +34,8 @@ def _rate(layers, mode):
     part = next(e for e in O.engines if getattr(e, "label", "") == "rolling")
     if mode == "none":                # the same settled bed, without the moment or the part
         O.engines = [e for e in O.engines if e is not part]
-        next(e for e in O.engines if getattr(e, "label", "") == "law").includeMoment = False
+        loop = next(e for e in O.engines if type(e).__name__ == "InteractionLoop")
+        loop.lawDispatcher.functors[0].includeMoment = False
         part = None
     elif mode == "every step":
         part.iterPeriod = 1

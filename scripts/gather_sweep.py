@@ -112,8 +112,10 @@ lines += [f"| {r['material']} | {r['rings']} | {r['layers']} | {r['packing']} | 
 
 def size_distribution(rs):
     """(sizes in mm, mean and standard deviation over the runs of the cumulative % passing)."""
-    tables = [np.loadtxt(Path(r["folder"]) / "size_distribution.csv", delimiter=",",
-                         skiprows=1) for r in rs]
+    paths = [Path(r["folder"]) / "size_distribution.csv" for r in rs]
+    tables = [np.loadtxt(p, delimiter=",", skiprows=1) for p in paths if p.exists()]
+    if not tables:                  # (summaries gathered without their folders' other files)
+        return None
     passing = np.array([t[:, 1] for t in tables])
     sd = passing.std(axis=0, ddof=1) if len(tables) > 1 else np.zeros(passing.shape[1])
     return 1e3 * tables[0][:, 0], passing.mean(axis=0), sd
@@ -123,7 +125,10 @@ def psd_panel(ax, sel, label_of, title):
     """Cumulative passing against size, one line per configuration, error bars at every fourth
     sieve (paper Figs. 21 and 23: 0.1 mm to the feed size)."""
     for k, r in enumerate(sel):
-        sizes, mean, sd = size_distribution(r["_runs"])
+        found = size_distribution(r["_runs"])
+        if found is None:
+            continue
+        sizes, mean, sd = found
         keep = (sizes >= 0.08) & (sizes <= 8.0)
         ax.semilogx(sizes[keep], mean[keep], "-", c=f"C{k}", label=label_of(r))
         marks = np.flatnonzero(keep)[::4]
