@@ -322,6 +322,8 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
     holder_radius = float(np.max(np.linalg.norm(lattice[:, :2], axis=1)) + size / 2.0
                           + 0.02 * size)
 
+    mats = {"ore": _material(material), "steel": _material("steel")}   # (cache key, info)
+
     def build():
         O.reset()
         ip2, _ = add_materials(labels, stiffness_scale=stiffness_scale)
@@ -362,13 +364,11 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
                 "stiffness_scale": stiffness_scale, "rolling": rolling, "overrides":
                 sorted([list(k), v] for k, v in overrides.items()),
                 "holder_radius": holder_radius}
-        mats = {"ore": _material(material), "steel": _material("steel")}
         folder = None if bed_cache is None else poured_bed.cache_folder(bed_cache)
         bodies, settled = poured_bed.cached_scene(folder, poured_bed.cache_key(spec, mats), build)
     else:
         bodies, settled = build()
     O.dt = YADE_DEFAULT_DT                    # attach() sets the run's time step
-    mats = {"ore": _material(material)}
     named = rolling_friction(labels, overrides)[1] if rolling else {}
     particles = bodies["particles"]
     centers = (lattice if packing == "lattice"
