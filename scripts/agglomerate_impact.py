@@ -13,13 +13,15 @@ Writes into --out: summary.json, timeseries.csv (every --sample-interval: damage
 broken by mode, bonds at >= 80 % of a strength, kinetic energy, debris), bonds_broken.csv (a line
 per bond as it breaks), agglomerate_impact.png (those against the document's reported times),
 damage_section.png and a ParaView series coloured by damage ratio (paraview/spheres.pvd).
+A checkpoint every --checkpoint-every s of wall time; a run that died goes on with --resume 1.
 """
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.scriptargs import integer, number, script_params, text  # noqa: E402
+from yadebreak.scriptargs import (checkpointed_run_options, integer, number,  # noqa: E402
+                                  script_params, text)
 
 args = script_params([
     text("material", "glass_epoxy", "the spheres and binder: a bonded-agglomerate material "
@@ -37,9 +39,8 @@ args = script_params([
             "intact bonds (1: every step, exact)", lo=1, hi=100000),
     number("sample_interval", 5e-6, "s", "simulated time between rows of timeseries.csv",
            lo=0, lo_open=True),
-    number("vtk_interval", 5e-5, "s", "simulated time between ParaView frames (0: none)", lo=0),
     integer("seed", 1, "random seed (packing and bond strengths)", lo=0),
-    text("out", "out/agglomerate_impact", "output folder"),
+    *checkpointed_run_options(5e-5, "out/agglomerate_impact"),
 ], __doc__)
 
 from yadebreak import agglomerate  # noqa: E402

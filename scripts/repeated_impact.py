@@ -24,8 +24,8 @@ from yadebreak import load_material, model, reports  # noqa: E402
 from yadebreak.scriptargs import (ScriptError, check_not_finished,  # noqa: E402
                                   check_resume_arguments, flag, integer, mark_finished,
                                   mark_started, material_option, number,
-                                  partial_outputs_on_failure, progress, read_period_option,
-                                  read_period_value,
+                                  partial_outputs_on_failure, progress, read_checkpoint,
+                                  read_period_option, read_period_value,
                                   resume_arguments, run_script, script_params, size_option,
                                   stop_if_asked, text, time_step_option)
 
@@ -67,7 +67,7 @@ def main(args):
     checkpoint = out / "checkpoint.yade.gz"
     if args.resume:
         check_not_finished(out, args)     # a finished run: says so, nothing is run or rewritten
-        brk, loop = coupling.load_checkpoint(checkpoint)
+        brk, loop = read_checkpoint(checkpoint, coupling.load_checkpoint)   # damaged: one line
         check_resume_arguments(loop["arguments"], args, checkpoint)
         ids, alive, fractions = loop["ids"], loop["alive"], loop["fractions"]
         home = {int(i): tuple(p) for i, p in loop["home"].items()}

@@ -60,7 +60,9 @@ def main(args):
     out.mkdir(parents=True, exist_ok=True)
     start = time.time()
     energies = [float(e) for e in args.energies.split(",")]
-    partial = PartialResults(out, args)
+    partial = PartialResults(out, args, validate=lambda energy, result: (
+        reports.check_breakage_result(result, mat, args.size, float(energy), target,
+                                      args.particles)))
     brk = None
 
     def write(end_reason, end_message):

@@ -5,6 +5,7 @@ import argparse
 import csv
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -198,3 +199,116 @@ def test_the_scalar_screen_never_misses_a_bond_near_its_strength(scene, tmp_path
     np.testing.assert_allclose(tensile[near], t[near], rtol=1e-12)
     assert np.all(tensile >= t - 1e-9 * st)                 # elsewhere an upper bound
     assert math.isfinite(float(np.max(shear)))
+
+
+def _rows(path):
+    with open(path) as f:
+        return list(csv.DictReader(f))
+
+
+def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(scene, tmp_path):
+    """Checkpoints, a kill after bonds broke past the last checkpoint (their lines written), and
+    --resume: bonds_broken.csv (each bond once), timeseries.csv and the summary (but for wall
+    times) are the uninterrupted run's to the last digit: checkpoints are written where every run
+    renews its contacts as a load would (bonded.renew_contacts)."""
+    from yade import O
+    from yadebreak import agglomerate
+    from yadebreak.coupling import bonded
+    from yadebreak.scriptargs import RunFinished, ScriptError
+    small = dict(particles=120, duration=1.5e-4)     # 89 of 431 bonds break, by 0.1 ms
+    whole = agglomerate.run(_args(tmp_path / "whole", checkpoint_every=-1.0, **small), quiet=True)
+    cut = tmp_path / "cut"
+    died = _args(cut, checkpoint_every=0.0, stop_after=4e-5, **small)   # at every renewal
+    assert agglomerate.run(died, quiet=True) is None
+    assert not (cut / "summary.json").exists()
+    O.reset()
+    saved, _ = bonded.load_checkpoint(cut / "checkpoint.yade.gz")
+    at_checkpoint = saved.watch.broken_count()
+    assert 0 < at_checkpoint < len(_rows(cut / "bonds_broken.csv"))
+    # goes on without checkpoints and dies again: more lines past the checkpoint
+    O.reset()
+    bonded._WATCHES.clear()                  # as in a new process
+    again = _args(cut, checkpoint_every=-1.0, stop_after=7e-5, resume=True, **small)
+    assert agglomerate.run(again, quiet=True) is None
+    assert len(_rows(cut / "bonds_broken.csv")) > at_checkpoint
+    with pytest.raises(ScriptError, match=r"other values of \['speed'\]"):
+        agglomerate.run(_args(cut, speed=5.0, resume=True, **small), quiet=True)
+    O.reset()
+    bonded._WATCHES.clear()
+    resumed = agglomerate.run(_args(cut, checkpoint_every=-1.0, resume=True, **small),
+                              quiet=True)
+    assert whole["bonds_broken_tension"] > at_checkpoint
+    for name in ("bonds_broken.csv", "timeseries.csv"):
+        assert (cut / name).read_text() == (tmp_path / "whole" / name).read_text(), name
+    log = _rows(cut / "bonds_broken.csv")
+    assert len({r["bond"] for r in log}) == len(log) == whole["bonds_broken_tension"]
+    cost = [d.pop("cost") for d in (resumed, whole)]
+    assert resumed == whole
+    for key in ("checks", "bonds_read"):
+        assert cost[0][key] == cost[1][key]
+    assert not (cut / "checkpoint.yade.gz").exists()
+    with pytest.raises(RunFinished):                   # finished: nothing to do, nothing rewritten
+        agglomerate.run(_args(cut, resume=True, **small), quiet=True)
+
+
+def test_a_damaged_checkpoint_is_refused_in_one_line(scene, tmp_path):
+    from yadebreak import agglomerate
+    from yadebreak.scriptargs import ScriptError
+    (tmp_path / "checkpoint.yade.gz").write_bytes(b"\x1f\x8b\x08garbage")
+    with pytest.raises(ScriptError, match=r"checkpoint.yade.gz is damaged .*run again without "
+                                          r"--resume$"):
+        agglomerate.run(_args(tmp_path, resume=True), quiet=True)
+    assert not (tmp_path / "summary.json").exists()
+
+
+def test_a_time_step_that_cannot_finish_is_refused_before_the_run(scene, tmp_path):
+    """--time-step-fraction 1e-18 makes the run need ~1e21 steps, beyond YADE's 64-bit step
+    counter; 1e-300 a time step whose square (in the rolling stiffness) is no float: both refused
+    in one line before a step is taken."""
+    from yade import O
+    from yadebreak import agglomerate
+    from yadebreak.coupling import AttachError
+    for fraction, steps in ((1e-18, r"needs \d\.\d+e\+2\d steps "),
+                            (1e-300, r"needs \d\.\d+e\+30\d steps ")):
+        with pytest.raises(AttachError) as info:
+            agglomerate.run(_args(tmp_path, particles=60, time_step_fraction=fraction), quiet=True)
+        message = str(info.value)
+        assert message.startswith(f"time_step_fraction = {fraction:g}: the time step ")
+        assert re.search(steps, message) and "glass_epoxy.toml" in message
+        assert message.endswith("accepted a time step >= 1e-150 s and at most 9.22e+18 steps "
+                                "(YADE's step counter)")
+        assert "\n" not in message and O.iter == 0
+
+
+def test_a_bonded_scene_loads_with_its_watch_and_a_plain_save_is_refused(scene, tmp_path):
+    """O.save does not store the BondWatch: bonded.save_checkpoint keeps it in O.tags, and after
+    a plain O.load of that file the first step restores it (the same bonds, modes, strengths and
+    counts, and the run goes on breaking bonds); a scene O.saved later, whose stored state is
+    stale, is refused at its first step rather than run with the wrong bonds."""
+    from yade import O
+    from yadebreak import agglomerate
+    from yadebreak.coupling import bonded
+    material, packing = agglomerate.build(_args(tmp_path, particles=60))
+    O.reset()
+    built = bonded.agglomerate_scene(material, packing, seed=3)
+    while built.watch.broken_count() < 3:
+        O.step()
+    before = built.watch
+    saved_mode, saved_checks = before.mode.copy(), before.checks
+    bonded.save_checkpoint(tmp_path / "c.yade.gz", built, {"any": 1})
+    O.run(20, True)
+    O.save(str(tmp_path / "plain.yade.gz"))               # the tags still hold the earlier state
+    bonded._WATCHES.clear()
+    O.load(str(tmp_path / "c.yade.gz"))
+    O.step()
+    watch = bonded._WATCHES[bonded.LABEL]
+    assert watch is not before
+    assert watch.checks == saved_checks + 1                   # the step after the load: checked
+    assert np.all(watch.mode[saved_mode != 0] == saved_mode[saved_mode != 0])
+    assert watch.broken_count() >= np.count_nonzero(saved_mode) >= 3
+    for a, b in zip(watch.net.strengths, before.net.strengths):
+        np.testing.assert_array_equal(a, b)
+    assert watch.touch_time == before.touch_time
+    O.load(str(tmp_path / "plain.yade.gz"))
+    with pytest.raises(RuntimeError, match=r"stored at step \d+ and the scene is at step \d+"):
+        O.step()

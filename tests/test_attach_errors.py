@@ -40,6 +40,35 @@ def test_attach_twice(scene):
         coupling.attach({"ore": "copper_ore"})
 
 
+def test_a_stiffness_scale_that_makes_a_modulus_absurd_is_refused(scene):
+    """stiffness_scale multiplies the files' moduli: 1e-300 would overflow the time step midway;
+    refused, one line, naming the material, its file, the value, the range and the unit."""
+    from yadebreak import coupling
+    with pytest.raises(coupling.AttachError) as info:
+        coupling.add_materials({"ore": "copper_ore", "steel": "steel"}, stiffness_scale=1e-300)
+    message = str(info.value)
+    assert message.startswith("material 'ore' (") and "copper_ore.toml) with stiffness_scale = " \
+        "1e-300: young = 5.2e-290 Pa is out of range: accepted in [100000, 1.5e+12] Pa" in message
+    assert "\n" not in message
+
+
+@pytest.mark.parametrize("field, value, shown", [
+    ("young", 1e-300, "young = 1e-300 Pa is out of range: accepted in [100000, 1.5e+12] Pa"),
+    ("density", 0.0, "density = 0 kg/m3 is out of range: accepted in [100, 25000] kg/m3"),
+    ("poisson", 0.7, "poisson = 0.7 is out of range: accepted in [0, 0.5)"),
+])
+def test_a_scene_material_out_of_its_physical_range_is_refused(scene, field, value, shown):
+    """A partner's YADE material made by hand (not from a file) is checked as files are."""
+    from yade import O, utils, wrapper
+    coupling = _scene()
+    wall = wrapper.FrictMat(label="wall", **{field: value})
+    O.materials.append(wall)
+    O.bodies.append(utils.wall(0.05, axis=0, material="wall"))
+    with pytest.raises(coupling.AttachError) as info:
+        coupling.attach({"ore": "copper_ore"})
+    assert str(info.value) == f"YADE material 'wall': {shown}"
+
+
 def test_non_sphere_with_breakable_material(scene):
     from yade import O, utils
     coupling = _scene()

@@ -188,6 +188,30 @@ def test_material_file_checked_field_by_field(tmp_path):
     assert "binder.radius_multiplier = 2 - is out of range: accepted (0, 1]" in text
 
 
+@pytest.mark.parametrize("old, new, problem", [
+    ("young_modulus = 3.0 ", "young_modulus = 1e-300 ",
+     "binder.young_modulus = 1e-300 GPa is out of range: accepted [0.0001, 1500] GPa"),
+    ("poisson_ratio = 0.4 ", "poisson_ratio = -0.5 ",
+     "binder.poisson_ratio = -0.5 - is out of range: accepted [0, 0.5)"),
+    ("density = 2500 ", "density = 1e-300 ",
+     "spheres.density = 1e-300 kg/m3 is out of range: accepted [100, 25000] kg/m3"),
+    ("young_modulus = 63 ", "young_modulus = 1e300 ",
+     "spheres.young_modulus = 1e+300 GPa is out of range: accepted [0.0001, 1500] GPa"),
+    ("diameter_min = 1.4 ", "diameter_min = 1e-300 ",
+     "spheres.diameter_min = 1e-300 mm is out of range: accepted [0.001, 1000] mm"),
+])
+def test_physically_absurd_values_are_refused(tmp_path, old, new, problem):
+    """The physical ranges of yadebreak/intervals.py, as for replacement materials: a binder of
+    1e-300 GPa would make the bonds' time scale overflow; spheres of 1e-300 mm, the time step."""
+    good = (MATERIALS_DIR / "glass_epoxy.toml").read_text()
+    assert old in good
+    bad = tmp_path / "bad.toml"
+    bad.write_text(good.replace(old, new))
+    with pytest.raises(MaterialError) as info:
+        bonds.load_agglomerate_material(bad)
+    assert info.value.problems == [problem]
+
+
 def test_the_two_kinds_of_material_file_are_told_apart():
     assert "glass_epoxy" not in available_materials()
     assert available_materials(kind="bonded_agglomerate") == ["glass_epoxy"]

@@ -188,3 +188,347 @@ def test_a_small_bed_says_why_it_took_longer(scene, tmp_path, capsys):
     assert f"{summary['initial_dt'] / summary['final_dt']:.0f}-fold" in line[0]
     assert f"{1e3 * summary['finest_sphere_size']:.2f} mm" in line[0]
     assert bed.why_it_took_longer({**summary, "final_dt": summary["initial_dt"]}) is None
+
+
+# -- faults lose nothing: one run per --out, signals, damaged files, a full disk, workers ----------
+def _run_script(main, args):
+    """run_script in this process: (exit code or None, stdout, stderr) via capsys by the caller."""
+    shown = warnings.showwarning
+    try:
+        return scriptargs.run_script(main, args)
+    finally:
+        warnings.showwarning = shown
+
+
+def _one_line(text):
+    lines = [line for line in text.splitlines() if line.strip()]
+    assert len(lines) == 1, text
+    return lines[0]
+
+
+def test_a_second_run_into_an_out_in_use_is_refused_and_a_killed_one_leaves_no_lock(tmp_path,
+                                                                                    capsys):
+    holder = subprocess.Popen(
+        ["nice", "-n", "5", sys.executable, "-c", "import sys, time; sys.path.insert(0, "
+         "sys.argv[1]); from yadebreak.scriptargs import lock_out; lock_out(sys.argv[2]); "
+         "print('locked', flush=True); time.sleep(120)", str(ROOT), str(tmp_path)],
+        stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        ran = []
+        with pytest.raises(SystemExit) as ended:
+            _run_script(ran.append, argparse.Namespace(out=str(tmp_path)))
+        assert ended.value.code == 2 and ran == []          # refused before the run began
+        line = _one_line(capsys.readouterr().err)
+        assert line == (f"[yadebreak] error: --out = {tmp_path}: another run is writing there "
+                        f"(process {holder.pid}, started " + line.split(", started ")[1])
+    finally:
+        holder.kill()                                        # kill -9: the kernel frees the lock
+        holder.wait()
+    assert _run_script(lambda args: "ran", argparse.Namespace(out=str(tmp_path))) == "ran"
+    assert scriptargs._LOCKS == {}                 # released when the run is over
+
+
+def test_a_signal_ends_the_run_as_interrupted_with_its_outputs(tmp_path, capsys):
+    """A signal within stop_points only asks to stop: the loop ends at its next stop point, with
+    its checkpoint (save) and its summary (partial_outputs_on_failure), exit code 128 + signal."""
+    import os
+    import signal
+    written, saved, steps = [], [], []
+
+    def main(args):
+        with scriptargs.partial_outputs_on_failure(lambda *end: written.append(end)), \
+                scriptargs.stop_points():
+            for step in range(5):
+                if step == 2:                                # the scheduler's wall-time limit
+                    os.kill(os.getpid(), signal.SIGTERM)
+                steps.append(step)                           # the step in hand is finished
+                scriptargs.stop_point(lambda: saved.append(step))
+    with pytest.raises(SystemExit) as ended:
+        _run_script(main, argparse.Namespace(out=str(tmp_path)))
+    assert ended.value.code == 143
+    assert steps == [0, 1, 2] and saved == [2]
+    assert written == [("interrupted", "stopped by SIGTERM")]
+    said = capsys.readouterr()
+    assert said.err == "" and said.out.splitlines()[-1].startswith(
+        "[yadebreak] interrupted (SIGTERM): ")       # (before it: YADE's greeting, if imported)
+    assert signal.getsignal(signal.SIGTERM) is not scriptargs._on_signal     # restored
+
+
+def test_a_second_signal_stops_at_once(tmp_path):
+    import os
+    import signal
+    reached = []
+
+    def main(args):
+        with scriptargs.stop_points():
+            os.kill(os.getpid(), signal.SIGINT)         # asks: the loop would stop at its point
+            reached.append("after the first")
+            os.kill(os.getpid(), signal.SIGINT)         # insists: stops here
+            reached.append("after the second")
+    with pytest.raises(SystemExit) as ended:
+        _run_script(main, argparse.Namespace(out=str(tmp_path)))
+    assert ended.value.code == 130 and reached == ["after the first"]
+
+
+@pytest.mark.yade
+def test_ctrl_c_inside_a_pyrunner_ends_as_interrupted_not_as_a_pyrunner_error(scene, tmp_path,
+                                                                              capsys):
+    """The signal strikes while YADE runs a PyRunner's Python: the step goes on to its end, and the
+    run stops after it as interrupted (exit 130), not as YADE's PyRunner error."""
+    from yade import wrapper
+    from yadebreak import coupling
+    scene.engines = [wrapper.ForceResetter(), wrapper.PyRunner(       # the signal, then more
+        command="import os, signal; os.kill(os.getpid(), signal.SIGINT); from yade import O; "
+                "O.tags['ran'] = str(int(O.tags['ran']) + 1)", iterPeriod=1, initRun=True)]
+    scene.dt = 1e-6
+    scene.tags["ran"] = "0"
+    written = []
+
+    def main(args):
+        with scriptargs.partial_outputs_on_failure(lambda *end: written.append(end)), \
+                scriptargs.stop_points():
+            for _ in range(3):
+                coupling.run_steps(1)
+                scriptargs.stop_point()
+    with pytest.raises(SystemExit) as ended:
+        _run_script(main, argparse.Namespace(out=str(tmp_path)))
+    said = capsys.readouterr()
+    assert ended.value.code == 130 and scene.iter == 1
+    assert int(scene.tags["ran"]) == scene.iter          # every PyRunner call ran to its end
+    assert written == [("interrupted", "stopped by Ctrl-C, SIGINT")]
+    assert "PyRunner" not in said.out + said.err
+
+
+def test_a_signal_wrapped_in_an_error_is_still_an_interruption(tmp_path):
+    """A signal outside stop_points raises where it strikes; inside a PyRunner YADE turns it into a
+    RuntimeError: the run still ends as interrupted."""
+    import signal
+    written = []
+    scriptargs._STOP["signal"] = signal.SIGINT
+    try:
+        with pytest.raises(RuntimeError):
+            with scriptargs.partial_outputs_on_failure(lambda *end: written.append(end)):
+                raise RuntimeError("PyRunner error.\nCOMMAND: ...\nKeyboardInterrupt")
+    finally:
+        scriptargs._STOP["signal"] = None
+    assert written == [("interrupted", "stopped by Ctrl-C, SIGINT")]
+
+
+def _partial_results(tmp_path, **changes):
+    """partial.json of a run at 100 J/kg, 10 particles of copper ore 5.5 mm on steel, 3 broken."""
+    from yadebreak import load_material
+    mat, steel = load_material("copper_ore"), load_material("steel")
+    args = argparse.Namespace(material="copper_ore", particles=10, energies="100", resume=False,
+                              stop_after=0)
+    result = {"specific_energy": 100.0, "particles": 10, "broken_fraction": 0.3,
+              "model_probability": float(mat.breakage_probability(100.0, 5.5e-3, partner=steel)),
+              "t10_simulated": 4.0, **changes}
+    scriptargs.PartialResults(tmp_path, args).add(100.0, result)
+    args.resume = True
+
+    def validate(key, result):
+        from yadebreak import reports
+        reports.check_breakage_result(result, mat, 5.5e-3, float(key), steel, args.particles)
+    return args, validate
+
+
+@pytest.mark.parametrize("damage, why", [
+    (lambda b: b[:len(b) // 2], "is damaged (JSONDecodeError"),
+    (lambda b: b"\xff\xfe" + b[2:], "is damaged (UnicodeDecodeError"),
+    (lambda b: b"", "is damaged (JSONDecodeError"),
+    (lambda b: b.replace(b'"broken_fraction": 0.3', b'"broken_fraction": 0.99'),
+     "was changed after it was written"),
+])
+def test_a_damaged_partial_file_is_refused_in_one_line(tmp_path, damage, why):
+    args, validate = _partial_results(tmp_path)
+    path = tmp_path / "partial.json"
+    path.write_bytes(damage(path.read_bytes()))
+    with pytest.raises(scriptargs.ScriptError) as refused:
+        scriptargs.PartialResults(tmp_path, args, validate)
+    assert str(refused.value).startswith(f"--resume: {path} ") and why in str(refused.value)
+    assert "\n" not in str(refused.value)
+
+
+@pytest.mark.parametrize("changes, why", [
+    ({"broken_fraction": 0.99, "particles": -3}, "particles = -3, not 10"),
+    ({"broken_fraction": 0.35}, "broken_fraction = 0.35 is not a count of 10 particles"),
+    ({"broken_fraction": 1.5}, "broken_fraction = 1.5: must be a number in [0, 1]"),
+    ({"model_probability": 0.5}, "model_probability = 0.5, the model gives"),
+])
+def test_a_result_this_run_could_not_have_written_is_refused(tmp_path, changes, why):
+    """With its digest made to match (the edit is not seen by it), the values themselves are
+    checked against the run's arguments and the model."""
+    args, validate = _partial_results(tmp_path, **changes)
+    assert scriptargs.PartialResults(tmp_path, args).done    # no check without validate
+    with pytest.raises(scriptargs.ScriptError, match="is not one this run could have written"):
+        scriptargs.PartialResults(tmp_path, args, validate)
+    with pytest.raises(scriptargs.ScriptError) as refused:
+        scriptargs.PartialResults(tmp_path, args, validate)
+    assert why in str(refused.value)
+
+
+def test_a_sound_partial_file_resumes(tmp_path):
+    args, validate = _partial_results(tmp_path)
+    assert scriptargs.PartialResults(tmp_path, args, validate).done["100.0"]["particles"] == 10
+
+
+@pytest.mark.yade
+@pytest.mark.parametrize("damage", ["truncated", "empty", "garbage"])
+def test_a_damaged_checkpoint_is_refused_in_one_line_claiming_nothing(scene, tmp_path, capsys,
+                                                                      damage):
+    from yadebreak import bed, coupling, mill
+    assert bed.run(_bed_args(tmp_path, checkpoint_every=0.0, stop_after=1e-4), quiet=True)[1] \
+        is None
+    path = tmp_path / "checkpoint.yade.gz"
+    good = path.read_bytes()
+    path.write_bytes({"truncated": good[:len(good) // 2], "empty": b"",
+                      "garbage": bytes(range(256)) * 40}[damage])
+    mill_out = tmp_path / "mill"
+    mill_out.mkdir()
+    (mill_out / "checkpoint.yade.gz").write_bytes(path.read_bytes())
+    for run, args in ((bed.run, _bed_args(tmp_path, resume=True)),
+                      (mill.run, argparse.Namespace(        # what it reads before the file
+                          size=6e-3, ball_size=15e-3, drum_diameter=0.12, lifter_height=6e-3,
+                          resume=True, out=str(mill_out)))):
+        coupling.forget()
+        scene.reset()
+        with pytest.raises(SystemExit) as ended:
+            _run_script(run, args)
+        assert ended.value.code == 2
+        said = capsys.readouterr()
+        line = _one_line(said.err)
+        assert line.startswith(f"[yadebreak] error: --resume: {args.out}/checkpoint.yade.gz is "
+                               "damaged (") and "kept" not in line and "summary" not in line
+        assert not (Path(args.out) / "summary.json").exists()
+
+
+def _full_disk(after):
+    """A writer that fills the disk: the first `after` calls write, the next ones raise ENOSPC
+    (having written part of their file, as a full disk does)."""
+    import errno
+    calls = []
+
+    def write(real):
+        def writer(path, *rest):
+            calls.append(path)
+            if len(calls) > after:
+                Path(str(path)).write_bytes(b"\x1f\x8b part")
+                raise OSError(errno.ENOSPC, "No space left on device", str(path))
+            return real(path, *rest)
+        return writer
+    return write, calls
+
+
+@pytest.mark.yade
+def test_a_full_disk_stops_the_run_in_one_line_keeping_the_last_checkpoint(scene, tmp_path,
+                                                                             capsys, monkeypatch):
+    """Checkpoints at every chunk of steps; the third one finds the disk full: the run stops with
+    one line naming what it wrote, summary.json says why, and the second checkpoint, whole, goes
+    on with --resume 1 to the end of the run."""
+    from yadebreak import bed, coupling
+    from yadebreak.coupling import engine
+    full, calls = _full_disk(after=2)
+    monkeypatch.setattr(engine, "save", full(engine.save))
+    with pytest.raises(SystemExit) as ended:
+        _run_script(bed.run, _bed_args(tmp_path, checkpoint_every=0.0, vtk_interval=1e-4))
+    assert ended.value.code == 1 and len(calls) == 3
+    line = _one_line(capsys.readouterr().err)
+    assert line.startswith("[yadebreak] error: the disk is full (OSError: [Errno 28] No space "
+                           "left on device: ")
+    assert (f"kept in {tmp_path}: summary.json (end_reason 'error'), checkpoint.yade.gz (of "
+            in line)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["end_reason"] == "error" and "[Errno 28]" in summary["end_message"]
+    assert sorted(p.name for p in tmp_path.iterdir() if "tmp" in p.name) == []
+    monkeypatch.undo()
+    coupling.forget()
+    scene.reset()
+    _, resumed = bed.run(_bed_args(tmp_path, resume=True), quiet=True)
+    assert resumed["end_reason"] == "finished"
+    assert resumed["final_mass"] == pytest.approx(resumed["initial_mass"], rel=1e-12)
+
+
+@pytest.mark.yade
+def test_a_disk_full_of_frames_and_summaries_says_nothing_was_summarised(scene, tmp_path, capsys,
+                                                                        monkeypatch):
+    """No frame and no summary can be written: the line says so and names only what exists."""
+    from yadebreak import bed, paraview
+    full, calls = _full_disk(after=1)                   # the first frame, then nothing
+    monkeypatch.setattr(paraview, "write_atomic", full(paraview.write_atomic))
+    monkeypatch.setattr(bed, "write_atomic", full(bed.write_atomic))
+    with pytest.raises(SystemExit) as ended:
+        _run_script(bed.run, _bed_args(tmp_path, checkpoint_every=-1.0, vtk_interval=1e-4))
+    assert ended.value.code == 1
+    line = _one_line(capsys.readouterr().err)
+    assert line.startswith("[yadebreak] error: the disk is full (OSError: [Errno 28] ")
+    assert line.endswith("; no summary.json was written") and "checkpoint" not in line
+    assert not (tmp_path / "summary.json").exists()
+
+
+@pytest.mark.yade
+def test_impact_workers_die_with_their_parent(tmp_path):
+    """single_impact --jobs 2 killed with -9: its YADE workers go with it (within 3 s)."""
+    import os
+    import signal
+    import time
+    proc = subprocess.Popen(["nice", "-n", "5", "yade", "-n", "-x",
+                             str(ROOT / "scripts" / "single_impact.py"), "--out", str(tmp_path),
+                             "--energies", "400", "--particles", "200", "--jobs", "2"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def children(pid):
+        found = []
+        for stat in Path("/proc").glob("[0-9]*/stat"):
+            try:
+                fields = stat.read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) == pid:
+                found.append(int(stat.parent.name))
+        return found
+    try:
+        deadline = time.time() + 60
+        while len(children(proc.pid)) < 2 and time.time() < deadline:
+            time.sleep(0.2)
+        workers = children(proc.pid)
+        assert len(workers) == 2
+    finally:
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    deadline = time.time() + 3
+    while any(Path(f"/proc/{w}").exists() for w in workers) and time.time() < deadline:
+        time.sleep(0.1)
+    alive = [w for w in workers if Path(f"/proc/{w}").exists()
+             and Path(f"/proc/{w}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"]
+    assert alive == []
+
+
+@pytest.mark.yade
+@pytest.mark.parametrize("signum, code, name", [(15, 143, "SIGTERM"), (2, 130, "Ctrl-C, SIGINT")])
+def test_a_signalled_bed_run_ends_interrupted_with_a_checkpoint(scene, tmp_path, signum, code,
+                                                                name):
+    """SIGTERM (a scheduler's wall-time limit) or SIGINT (Ctrl-C) once the impact runs: exit code
+    128 + signal, one line naming what is kept, summary.json 'interrupted' and a whole checkpoint
+    of the state it summarises (resuming from a checkpoint: tests/test_resume.py)."""
+    import os
+    bed = ["nice", "-n", "5", "yade", "-n", "-x", str(ROOT / "scripts" / "bed_impact.py"), "--out",
+           str(tmp_path), "--rings", "1", "--energy", "0.6", "--vtk-interval", "0"]
+    proc = subprocess.Popen(bed, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    for line in proc.stdout:
+        if "particles of copper_ore" in line:             # the scene is built, the ball falls
+            os.kill(proc.pid, signum)
+            break
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == code, out + err
+    last = out.strip().splitlines()[-1]
+    assert last.startswith(f"[yadebreak] interrupted ({name}): kept in {tmp_path}: summary.json "
+                           "(end_reason 'interrupted'), checkpoint.yade.gz (of "), last
+    assert "Traceback" not in err
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["end_reason"] == "interrupted" and summary["end_message"] == f"stopped by {name}"
+    from yadebreak import coupling
+    _, state = scriptargs.read_checkpoint(tmp_path / "checkpoint.yade.gz",
+                                          coupling.load_checkpoint)   # whole, where it stopped
+    assert scene.time == pytest.approx(summary["simulated_time"], rel=1e-12)
+    assert scene.iter == summary["steps"] and state["arguments"]["rings"] == 1

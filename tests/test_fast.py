@@ -64,7 +64,50 @@ def test_fast_wall_impacts_receive_e_m_v2_over_2_within_3_percent(scene):
     got = {ev["id"]: ev["specific_energy"] for ev in brk.events if ev["kind"] == "damage"}
     for i, v in zip(ids, speeds):
         assert got[i] == pytest.approx(e * v * v / 2, rel=0.03)
-    assert max(periods) >= 5                  # it did read less often than every step
+
+
+@pytest.mark.yade
+def test_fast_reads_less_often_where_a_fresh_contact_cannot_bring_much_energy(scene):
+    """At 1 m/s a fresh contact brings the weakest 5.5 mm copper ore particles 2 % of their
+    fracture energy only after several steps (hertz_onset_time): "fast" waits that long."""
+    from yadebreak import scenes
+    from yadebreak.coupling._yade import O
+    from yadebreak.coupling.stepping import ONSET_QUANTILE
+    brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=[1.0], read_period="fast")
+    cu = load_material("copper_ore")
+    onset = placement.hertz_onset_time(2.75e-3, cu.density, cu.young_modulus, cu.poisson_ratio,
+                                       2.0, 0.02 * cu.fracture_energy_ppf(ONSET_QUANTILE, 5.5e-3))
+    scenes.run_steps(20)
+    assert brk.period == min(int(0.25 * placement.hertz_loading_time(
+        2.75e-3, cu.density, cu.young_modulus, cu.poisson_ratio, 2.0) / O.dt),
+        int(onset / O.dt))
+    assert brk.period >= 5                    # it does read less often than every step
+
+
+def test_hertz_onset_time_against_an_integrated_hertz_impact():
+    """The closed form e = 2 E* / (5 pi rho) (v t / R)^2.5 against the work of F = kno d^1.5
+    integrated along a sphere's own Hertz impact on a rigid wall (semi-implicit Euler, 1e5
+    steps), while the overlap is still small against its largest (the form's assumption)."""
+    cu = load_material("copper_ore")
+    radius, speed = 2.75e-3, 10.0
+    mass = cu.density * 4.0 / 3.0 * np.pi * radius ** 3
+    kno = 4.0 / 3.0 * cu.young_modulus / (1.0 - cu.poisson_ratio ** 2) * np.sqrt(radius)
+    energy = 0.2                               # J/kg: 0.4 % of v^2 / 2, early in the loading
+    t_form = float(placement.hertz_onset_time(radius, cu.density, cu.young_modulus,
+                                              cu.poisson_ratio, speed, energy))
+    dt = t_form / 1e5
+    v, d, t, work = speed, 0.0, 0.0, 0.0
+    while work / mass < energy:
+        force = kno * d ** 1.5
+        v -= force / mass * dt
+        work += force * v * dt
+        d += v * dt
+        t += dt
+    assert t == pytest.approx(t_form, rel=0.01)
+    # the time scales as 1/v at a given energy and as e^0.4
+    assert float(placement.hertz_onset_time(radius, cu.density, cu.young_modulus,
+                                            cu.poisson_ratio, 2 * speed, energy)) == \
+        pytest.approx(t_form / 2)
 
 
 @pytest.mark.yade

@@ -1,5 +1,7 @@
 """The material library and its validation (no YADE needed)."""
 import dataclasses
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -96,6 +98,58 @@ def test_each_validation_error_names_field_and_range(tmp_path, old, new, message
     with pytest.raises(MaterialError, match=message) as info:
         load_material(_write(tmp_path, GOOD.replace(old, new)))
     assert str(tmp_path / "bad.toml") in str(info.value)
+
+
+# physically absurd values, refused before a run (a modulus of 1e-300 GPa used to overflow the
+# time step midway): the ranges of yadebreak/intervals.py, in the file's unit
+@pytest.mark.parametrize("old, new, message", [
+    ("young_modulus = 52 ", "young_modulus = 1e-300 ",
+     r"elastic.young_modulus = 1e-300 GPa is out of range: accepted \[0.0001, 1500\] GPa$"),
+    ("young_modulus = 52 ", "young_modulus = 1e4 ", r"elastic.young_modulus = 10000 GPa"),
+    ("density = 2930 ", "density = 1e-300 ",
+     r"elastic.density = 1e-300 kg/m3 is out of range: accepted \[100, 25000\] kg/m3$"),
+    ("poisson_ratio = 0.25 ", "poisson_ratio = -0.3 ",
+     r"elastic.poisson_ratio = -0.3 - is out of range: accepted \[0, 0.5\)$"),
+    ("d0 = 8.07 ", "d0 = 1e300 ", r"breakage.d0 = 1e\+300 mm is out of range: accepted "
+                                  r"\[0.001, 1000\] mm$"),
+    ("d0 = 8.07 ", "d0 = 1e-300 ", r"breakage.d0 = 1e-300 mm"),
+    ("device_stiffness = 230 ", "device_stiffness = 1e-300 ",
+     r"breakage.device_stiffness = 1e-300 GPa is out of range: accepted \[0.0001, 1500\] GPa$"),
+])
+def test_physically_absurd_values_are_refused_in_one_line(tmp_path, old, new, message):
+    assert old in GOOD
+    with pytest.raises(MaterialError) as info:
+        load_material(_write(tmp_path, GOOD.replace(old, new)))
+    assert len(info.value.problems) == 1
+    assert re.search(message, info.value.problems[0]), info.value.problems[0]
+
+
+def test_within_the_ranges_the_rayleigh_time_step_is_finite_and_positive():
+    """What intervals.py's ranges promise: at their corners, the Rayleigh time of a sphere of
+    radius R (m) lies within 4.1e-5 R and 2.9 R s, so no material file can overflow the time step
+    (the smallest radius of the size range gives a step well above float's smallest)."""
+    from yadebreak import intervals, placement
+    corners = [placement.rayleigh_time(1.0, rho, young, nu)
+               for rho in (intervals.DENSITY.lo, intervals.DENSITY.hi)
+               for young in (intervals.YOUNG_MODULUS.lo, intervals.YOUNG_MODULUS.hi)
+               for nu in (intervals.POISSON_RATIO.lo, np.nextafter(intervals.POISSON_RATIO.hi, 0))]
+    assert 4.1e-5 < min(corners) and max(corners) < 2.9
+    assert 4.1e-5 * intervals.PARTICLE_SIZE.lo / 2 > 1e-12
+
+
+@pytest.mark.yade
+def test_a_script_refuses_an_absurd_material_in_one_line_before_running(tmp_path):
+    import subprocess
+    path = _write(tmp_path, GOOD.replace("young_modulus = 52 ", "young_modulus = 1e-300 "))
+    script = Path(yadebreak.__file__).resolve().parent.parent / "scripts" / "single_impact.py"
+    proc = subprocess.run(["yade", "-n", "-x", str(script), "--material", str(path),
+                           "--energies", "100", "--particles", "2", "--out", str(tmp_path / "o")],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2
+    errors = [line for line in proc.stderr.splitlines() if "[yadebreak]" in line]
+    assert errors == [f"[yadebreak] error: {path}: elastic.young_modulus = 1e-300 GPa is out of "
+                      "range: accepted [0.0001, 1500] GPa"]
+    assert not (tmp_path / "o" / "summary.json").exists()
 
 
 def test_all_problems_reported_at_once(tmp_path):

@@ -4,6 +4,7 @@ count every stressing event (bad input: tests/test_script_options.py)."""
 import argparse
 import json
 import math
+import time
 
 import pytest
 
@@ -82,7 +83,9 @@ def test_a_resumed_mill_goes_on_from_its_checkpoint_and_refuses_other_arguments(
     coupling.forget()
     O.reset()
     cut = _args(tmp_path / "cut", duration=0.04, checkpoint_every=0.0, stop_after=0.02)
+    began = time.time()
     assert mill.run(cut, quiet=True)[1] is None
+    first = time.time() - began                  # (its last checkpoint: at its very end)
     before_cut = [json.loads(x) for x in
                   (tmp_path / "cut" / "events.jsonl").read_text().splitlines()]
     coupling.forget()
@@ -92,8 +95,15 @@ def test_a_resumed_mill_goes_on_from_its_checkpoint_and_refuses_other_arguments(
                        speed=0.7), quiet=True)
     coupling.forget()
     O.reset()
+    began = time.time()
     _, resumed = mill.run(_args(tmp_path / "cut", duration=0.04, checkpoint_every=0.0,
                                 resume=True), quiet=True)
+    second = time.time() - began
+    # the run's wall time and throughput count both invocations, not the last one alone (the
+    # first up to its last checkpoint: a busy disk may delay that one's end)
+    assert second + 0.5 * first < resumed["runtime_s"] < second + first
+    assert resumed["throughput_s_per_hour"] == pytest.approx(
+        3600 * resumed["simulated_time"] / resumed["runtime_s"], rel=1e-12)
     assert before_cut and before_cut == whole_events[:len(before_cut)]
     assert resumed["end_reason"] == "finished" and resumed["mass_relative_error"] < 1e-9
     assert resumed["simulated_time"] == pytest.approx(whole["simulated_time"],

@@ -31,7 +31,8 @@ def _one_error_line(proc):
 # (script, arguments, the error line's "option = value", the range, the unit)
 BAD_VALUES = [
     ("bed_impact", ["--energy", "-1"], "--energy = -1", "> 0", "(J)"),
-    ("bed_impact", ["--size=-5e-3"], "--size = -5e-3", "in (0, 1]", "(m)"),
+    ("bed_impact", ["--size=-5e-3"], "--size = -5e-3", "in [1e-06, 1]", "(m)"),
+    ("single_impact", ["--size", "1e-300"], "--size = 1e-300", "in [1e-06, 1]", "(m)"),
     ("bed_impact", ["--rings=-1"], "--rings = -1", "an integer >= 0", "(no unit)"),
     ("bed_impact", ["--layers", "0"], "--layers = 0", "an integer >= 1", "(no unit)"),
     ("bed_impact", ["--energy", "2J/kg"], "--energy = 2J/kg", "> 0", "(J)"),

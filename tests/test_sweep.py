@@ -67,6 +67,25 @@ def test_table_errors_name_the_file_and_line(tmp_path):
         sweep.read_table(tmp_path / "none.table")
 
 
+def test_a_repeated_column_is_refused_naming_the_file_line_and_column(tmp_path):
+    """yade-batch would run such a table with the last of the two values: refused before any
+    run, whether the repeat is marked '!' or not."""
+    table = _table(tmp_path, "# energies\n\nenergy seed energy\n1 2 3\n", "twice.table")
+    with pytest.raises(sweep.SweepError, match=r"twice.table:3: column 3, 'energy', repeats "
+                                               r"column 1") as info:
+        sweep.read_table(table)
+    assert "\n" not in str(info.value)
+    with pytest.raises(sweep.SweepError, match=r":1: column 2, 'a', repeats column 1"):
+        sweep.read_table(_table(tmp_path, "a! a\n1 2\n", "marked.table"))
+    proc = subprocess.run([sys.executable, "-m", "yadebreak", "sweep", str(table), str(SCRIPT),
+                           "--out", str(tmp_path / "out")], capture_output=True, text=True,
+                          cwd=ROOT, timeout=120)
+    assert proc.returncode == 2 and not (tmp_path / "out" / "sweep.json").exists()
+    assert proc.stderr.strip().splitlines() == [
+        f"[yadebreak] error: table {table}:3: column 3, 'energy', repeats column 1 (each "
+        "parameter once)"]
+
+
 def test_flatten_gives_dotted_names():
     assert sweep.flatten({"a": 1, "results": [{"b": 2, "c": [3, 4]}], "d": {"e": None}}) == {
         "a": 1, "results.0.b": 2, "results.0.c.0": 3, "results.0.c.1": 4, "d.e": None}

@@ -6,6 +6,12 @@ onto a steel plane and followed for --duration seconds from its first touch (t =
 document's video frames). Every --sample-interval it records the damage ratio, the bonds broken
 by mode, the bonds at >= 80 % of a strength, the kinetic energy and the debris that has left the
 agglomerate; at the end, the fragments (connected components of the surviving bonds).
+
+Checkpoints as the bed's and the mill's (--checkpoint-every s of wall time, into
+<out>/checkpoint.yade.gz, the BondWatch's state with the scene); --resume 1 goes on from the last
+one: bonds_broken.csv is rewritten from the checkpoint's broken bonds (the lines a killed run wrote
+after it are dropped, then written again as the run breaks them) and the time series goes on from
+the checkpoint's rows.
 """
 from __future__ import annotations
 
@@ -20,9 +26,12 @@ from scipy.spatial import cKDTree
 
 from . import bonds, paraview
 from .coupling._yade import O, utils
+from .coupling import bonded
 from .coupling.bonded import WATCH_LEVEL, agglomerate_scene
 from .coupling.engine import run_steps
-from .scriptargs import partial_outputs_on_failure, progress, time_left
+from .scriptargs import (CHECKPOINT, check_not_finished, check_resume_arguments, mark_finished,
+                         mark_started, partial_outputs_on_failure, progress, read_checkpoint,
+                         resume_arguments, stop_point, stop_points, time_left)
 
 #: the document's agglomerate: 4,104 spheres in a 30 mm mould; --particles keeps its packing
 #: density (spheres' volume over the mould's)
@@ -36,6 +45,10 @@ DOCUMENT_DEBRIS_MS = 0.44
 DEBRIS_GAP = 1.0
 #: spheres at or above this damage ratio form the damaged zone (the document's Fig. 12d: > 0.1)
 DAMAGED = 0.1
+#: steps between two renewals of the contacts (bonded.renew_contacts), at the first sample after
+#: them; checkpoints are written there. 200: 1-2 % of the run's time at 4,104 spheres, and
+#: SIGTERM is answered within 200 steps (5 s of the document's case)
+RENEW_STEPS = 200
 
 SERIES_FIELDS = ["time_ms", "damage_ratio", "broken_tension", "broken_shear",
                  "broken_compression", "above80_tension", "above80_shear", "above80_compression",
@@ -49,12 +62,18 @@ def solid_fraction_of_document(spheres):
     return (mould / DOCUMENT_DIAMETER) ** 3
 
 
-def build(args):
-    """(material, packing): the material with --radius-multiplier applied, and the agglomerate's
-    spheres packed in their mould (seeded by --seed)."""
+def material_of(args):
+    """The material of --material with --radius-multiplier applied."""
     material = bonds.load_agglomerate_material(args.material)
     if args.radius_multiplier > 0:
         material = material.with_binder(radius_multiplier=args.radius_multiplier)
+    return material
+
+
+def build(args):
+    """(material, packing): the material with --radius-multiplier applied, and the agglomerate's
+    spheres packed in their mould (seeded by --seed)."""
+    material = material_of(args)
     rng = np.random.default_rng(args.seed)
     diameters = bonds.sphere_diameters(args.particles, material.spheres, rng)
     mould = bonds.mould_diameter_for(args.particles, material.spheres,
@@ -62,36 +81,80 @@ def build(args):
     return material, bonds.pack_in_sphere(diameters, mould, rng)
 
 
-def run(args, quiet=False):
-    """The whole run: build, impact, outputs. Returns the summary (a dict)."""
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    say = (lambda message: None) if quiet else progress
-    start = time.time()
+def _start(args, out, say, start):
+    """(material, packing, scene, loop state): built, or from the checkpoint (--resume 1). The
+    loop state: the time series so far and the wall time of earlier invocations."""
+    if getattr(args, "resume", False):
+        check_not_finished(out, args)       # a finished run: says so, nothing is run or rewritten
+        scene, data = read_checkpoint(out / CHECKPOINT, bonded.load_checkpoint)
+        check_resume_arguments(data["arguments"], args, out / CHECKPOINT)
+        loop = data["loop"]
+        packing = bonds.Packing(**{k: np.array(v) if isinstance(v, list) else v
+                                   for k, v in loop.pop("packing").items()})
+        scene.impact_seconds = loop["impact_s"]
+        say(f"resumed from {out / CHECKPOINT} at t = {loop['series'][-1]['time_ms']:.4f} ms "
+            f"after the touch, iteration {O.iter}, {scene.watch.broken_count()} bonds broken")
+        return material_of(args), packing, scene, loop
+    mark_started(out)
+    (out / CHECKPOINT).unlink(missing_ok=True)      # an earlier run's: --resume must not find it
     material, packing = build(args)
     O.reset()
     scene = agglomerate_scene(material, packing, seed=args.seed, speed=args.speed,
                               time_step_fraction=args.time_step_fraction,
-                              check_period=args.check_period)
-    watch = scene.watch
-    bonds_initial = len(watch.mode)
+                              check_period=args.check_period, duration=args.duration)
+    bonds_initial = len(scene.watch.mode)
     say(f"{args.particles} spheres in a {2e3 * packing.mould_radius:.1f} mm mould, "
         f"{bonds_initial} bonds ({2 * bonds_initial / args.particles:.2f} per sphere), dt "
         f"{O.dt:.3g} s, built in {time.time() - start:.1f} s")
+    return material, packing, scene, {"series": [], "runtime_s": 0.0, "impact_s": 0.0,
+                                      "renew_at": 0}
+
+
+def _checkpoint(out, scene, packing, loop, args, runtime_s):
+    """The scene with its BondWatch, the loop state and the run's arguments."""
+    state = {**loop, "runtime_s": runtime_s, "impact_s": scene.impact_seconds,
+             "packing": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                         for k, v in vars(packing).items()}}
+    bonded.save_checkpoint(out / CHECKPOINT, scene, {"loop": state,
+                                                     "arguments": resume_arguments(args)})
+
+
+def run(args, quiet=False):
+    """The whole run: build (or resume), impact, outputs. Returns the summary (a dict), None if
+    it stopped early on purpose (--stop-after, tests)."""
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    say = (lambda message: None) if quiet else progress
+    start = time.time()
+    material, packing, scene, loop = _start(args, out, say, start)
+    watch = scene.watch
+    bonds_initial = len(watch.mode)
     log = FailureLog(out / "bonds_broken.csv", watch, packing)
     watch.on_failure = log.write
-    series = []
+    series = loop["series"]
     frames = paraview.series(out / "paraview", None, args.vtk_interval,
+                             resume=getattr(args, "resume", False),
+                             wall_patch=((0.0, 0.0, 0.0),
+                                         paraview.WALL_MARGIN * packing.mould_radius),
                              sphere_arrays=lambda ids: _paraview_arrays(ids, scene))
+
+    def runtime_s():                      # over every invocation, up to its last checkpoint
+        return loop["runtime_s"] + time.time() - start
 
     def write(end_reason, end_message):
         log.close()
-        return _outputs(args, out, material, packing, scene, series, start, end_reason, end_message)
+        return _outputs(args, out, material, packing, scene, series, runtime_s(), end_reason,
+                        end_message)
 
-    with partial_outputs_on_failure(write):
-        _impact(args, scene, packing, series, frames, say, start)
+    with partial_outputs_on_failure(write), stop_points():
+        ended = _impact(args, out, scene, packing, loop, frames, say, start, runtime_s)
+        if ended is None:
+            log.close()
+            return None
         frames.close()
     summary = write("finished", "")
+    mark_finished(out, args)                      # --resume 1 now says so and does nothing
+    (out / CHECKPOINT).unlink(missing_ok=True)    # a mid-run state, of no more use
     say(f"{watch.broken_count()} of {bonds_initial} bonds broken (tension "
         f"{watch.broken_count(bonds.TENSION)}, shear {watch.broken_count(bonds.SHEAR)}, "
         f"compression {watch.broken_count(bonds.COMPRESSION)}), mean damage ratio "
@@ -99,21 +162,40 @@ def run(args, quiet=False):
     return summary
 
 
-def _impact(args, scene, packing, series, frames, say, start):
-    """Step to the first touch, then for --duration, sampling every --sample-interval."""
-    watch = scene.watch
+def _impact(args, out, scene, packing, loop, frames, say, start, runtime_s):
+    """Step to the first touch, then for --duration, sampling every --sample-interval, with
+    checkpoints every --checkpoint-every s of wall time. "finished", or None if it stopped at
+    --stop-after (s of simulated time; tests: as if killed there). Every RENEW_STEPS steps, at a
+    sample, the contacts are renewed as a load would (bonded.renew_contacts): there a checkpoint
+    is written if one is due, or if SIGINT or SIGTERM came (within stop_points), and a run
+    resumed from it goes on exactly as this one."""
+    watch, series = scene.watch, loop["series"]
     chunk = max(1, int(round(args.sample_interval / O.dt)))
-    while watch.touch_time is None:
-        run_steps(1)
-        if O.time > 1.0:
-            raise RuntimeError("the agglomerate never reached the plane in 1 s")
-    said = began = time.time()
-    series.append(_sample(scene, packing))
+    every = getattr(args, "checkpoint_every", -1.0)
+    stop_after = getattr(args, "stop_after", 0.0)
+    if watch.touch_time is None:
+        while watch.touch_time is None:
+            run_steps(1)
+            if O.time > 1.0:
+                raise RuntimeError("the agglomerate never reached the plane in 1 s")
+        series.append(_sample(scene, packing))
+    said = began = last_checkpoint = time.time()
+    impact_before = scene.impact_seconds
     while O.time - watch.touch_time < args.duration - 0.5 * O.dt:
         left = int(math.ceil((args.duration - (O.time - watch.touch_time)) / O.dt - 1e-9))
         run_steps(min(chunk, max(left, 1)))
         series.append(_sample(scene, packing))
         frames()
+        scene.impact_seconds = impact_before + time.time() - began
+        if O.iter >= loop["renew_at"]:
+            bonded.renew_contacts()
+            loop["renew_at"] = O.iter + RENEW_STEPS
+            if every >= 0 and time.time() - last_checkpoint >= every:
+                _checkpoint(out, scene, packing, loop, args, runtime_s())   # --resume goes on here
+                last_checkpoint = time.time()
+            stop_point(lambda: _checkpoint(out, scene, packing, loop, args, runtime_s()))
+        if stop_after and O.time >= stop_after:
+            return None                           # (tests) as if the run had died here
         if time.time() - said > 10.0:
             said = time.time()
             row = series[-1]
@@ -122,7 +204,7 @@ def _impact(args, scene, packing, series, frames, say, start):
                 f"{row['damage_ratio']:.3f}, broken {row['broken_tension']} tension / "
                 f"{row['broken_shear']} shear / {row['broken_compression']} compression, "
                 f"{time.time() - start:.0f} s, {time_left(time.time() - began, done)}")
-        scene.impact_seconds = time.time() - began
+    return "finished"
 
 
 def _sample(scene, packing):
@@ -166,12 +248,20 @@ class FailureLog:
     FIELDS = ["bond", "sphere_a", "sphere_b", "time_ms", "mode", "x", "y", "z"]
 
     def __init__(self, path, watch, packing):
+        """A new file, holding the bonds `watch` has broken so far (a resumed run: those of its
+        checkpoint, in the order they broke; lines a killed run wrote after it are dropped)."""
         self.file = open(path, "w", newline="")
         self.writer = csv.writer(self.file)
         self.writer.writerow(self.FIELDS)
         self.watch = watch
         pairs = watch.net.pairs
         self.midpoints = 0.5 * (packing.positions[pairs[:, 0]] + packing.positions[pairs[:, 1]])
+        broken = np.flatnonzero(watch.mode != bonds.INTACT)
+        # a step breaks its bonds in ascending row order (BondWatch._break)
+        broken = broken[np.lexsort((broken, watch.failed_at[broken]))]
+        for t in np.unique(watch.failed_at[broken]):
+            rows = broken[watch.failed_at[broken] == t]
+            self.write(rows, watch.mode[rows], t)
 
     def write(self, rows, modes, now):
         t = (now - self.watch.touch_time) * 1e3
@@ -239,7 +329,7 @@ def _first_time(series, key, above=0):
     return None
 
 
-def _outputs(args, out, material, packing, scene, series, start, end_reason, end_message):
+def _outputs(args, out, material, packing, scene, series, runtime_s, end_reason, end_message):
     """summary.json, timeseries.csv and the plots; returns the summary."""
     watch = scene.watch
     damage = watch.damage_ratios()
@@ -283,7 +373,7 @@ def _outputs(args, out, material, packing, scene, series, start, end_reason, end
                                if series and series[-1]["debris_spheres"] else None),
             "document_debris_ms": DOCUMENT_DEBRIS_MS,
             **zone_measures(packing, damage)},
-        "cost": {"runtime_s": time.time() - start, "impact_s": impact_seconds,
+        "cost": {"runtime_s": runtime_s, "impact_s": impact_seconds,
                  "criterion_s": watch.seconds, "checks": watch.checks,
                  "bonds_read": watch.bonds_read, "check_period": watch.check_period},
         "end_reason": end_reason, "end_message": end_message,

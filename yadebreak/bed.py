@@ -12,8 +12,9 @@ import numpy as np
 from . import coupling, paraview, poured_bed, scenes
 from .coupling._yade import O
 from .scriptargs import (check_not_finished, check_resume_arguments, mark_finished, mark_started,
-                         partial_outputs_on_failure, progress, read_period_value,
-                         resume_arguments, time_left)
+                         partial_outputs_on_failure, progress, read_checkpoint, read_period_value,
+                         resume_arguments, run_wall_time, stop_point, stop_points, time_left,
+                         write_atomic)
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
 TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
@@ -40,8 +41,10 @@ def capture_radius(brk, info):
     return max(radii) if radii else 0.0
 
 
-def _checkpoint(path, info, loop, args):
-    """The scene, the loop's own state and the run's arguments (coupling.save_checkpoint)."""
+def _checkpoint(path, info, loop, args, start):
+    """The scene, the loop's own state (with the run's wall time so far, from the invocation's
+    `start`) and the run's arguments (coupling.save_checkpoint)."""
+    loop["wall_s"] = run_wall_time(loop, start)
     coupling.save_checkpoint(path, {
         "loop": loop, "info": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
                                for k, v in info.items() if k != "material"},
@@ -50,7 +53,7 @@ def _checkpoint(path, info, loop, args):
 
 def _resume(path, args):
     """The checkpoint's scene, refused (naming them) if it was run with other arguments."""
-    brk, data = coupling.load_checkpoint(path)
+    brk, data = read_checkpoint(path, coupling.load_checkpoint)
     if "arguments" in data:                 # (checkpoints written before they were recorded: not)
         check_resume_arguments(data["arguments"], args, path)
     info = data["info"]
@@ -78,6 +81,7 @@ def _start(args, out, energy, say):
     if getattr(args, "resume", False):
         check_not_finished(out, args)       # a finished run: says so, nothing is run or rewritten
         brk, info, loop = _resume(checkpoint, args)
+        loop["wall_before_s"] = loop.get("wall_s", 0.0)   # the run's wall time: all invocations
         say(f"resumed from {checkpoint} at t = {1e3 * O.time:.3f} ms, iteration {O.iter}")
         return brk, info, loop
     mark_started(out)
@@ -160,8 +164,10 @@ def _impact(brk, info, loop, args, out, start, say, frames):
             return "time_limit"
         now = time.time()
         if every >= 0 and now - last_checkpoint >= every:
-            _checkpoint(out / "checkpoint.yade.gz", info, loop, args)  # --resume 1 goes on here
+            _checkpoint(out / "checkpoint.yade.gz", info, loop, args, start)  # --resume 1 goes on
             last_checkpoint = now
+        # SIGINT, SIGTERM (run() catches them in stop_points): end here, checkpointed
+        stop_point(lambda: _checkpoint(out / "checkpoint.yade.gz", info, loop, args, start))
         if stop_after and O.time >= stop_after:
             return None                           # (tests) as if the run had died here
         if now - last_report > 5.0:
@@ -180,19 +186,24 @@ def run(args, quiet=False):
     energy = args.energy if args.speed <= 0 else 0.5 * scenes.BALL_MASS * args.speed ** 2
     start = time.time()
     say = (lambda m: None) if quiet else progress
-    brk, info, loop = _start(args, out, energy, say)
-    frames = _paraview(args, out, brk, info)
+    # SIGINT, SIGTERM from here on: the run ends at its loop's next stop_point, checkpointed
+    with stop_points():
+        brk, info, loop = _start(args, out, energy, say)
+        frames = _paraview(args, out, brk, info)
 
-    def partial(end_reason, end_message):         # the outputs so far; the checkpoint is kept
-        _report(brk, info, loop, args, out, energy, time.time() - start, end_reason, end_message)
+        def runtime():                                # s: the whole run's, over its invocations
+            return run_wall_time(loop, start)
 
-    with partial_outputs_on_failure(partial):
-        ended = _impact(brk, info, loop, args, out, start, say, frames)
+        def partial(end_reason, end_message):         # the outputs so far; the checkpoint is kept
+            _report(brk, info, loop, args, out, energy, runtime(), end_reason, end_message)
+
+        with partial_outputs_on_failure(partial):
+            ended = _impact(brk, info, loop, args, out, start, say, frames)
     if ended is None:
         return brk, None
     brk.finish()
     frames.close()                                # the last frame, with the events closed
-    summary = _report(brk, info, loop, args, out, energy, time.time() - start, ended,
+    summary = _report(brk, info, loop, args, out, energy, runtime(), ended,
                       "" if ended == "finished" else f"stopped at --max-time {args.max_time} s")
     mark_finished(out, args)                      # --resume 1 now says so and does nothing
     (out / "checkpoint.yade.gz").unlink(missing_ok=True)    # a mid-run state, of no more use
@@ -234,7 +245,7 @@ def _report(brk, info, loop, args, out, energy, runtime, end_reason, end_message
         "wall_time_read_s": brk.wall_time["read"], "wall_time_replace_s": brk.wall_time["replace"],
         "end_reason": end_reason, "end_message": end_message,
     }
-    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    write_atomic(out / "summary.json", json.dumps(summary, indent=2))
     with open(out / "size_distribution.csv", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["size_m", "passing_percent"])

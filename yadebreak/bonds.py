@@ -22,8 +22,9 @@ from scipy import sparse, stats
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
+from .intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS
 from .materials import (MaterialError, _check_keys, _find, _number, _read_table,
-                        available_materials)
+                        available_materials, in_file_unit)
 
 #: failure modes, as stored per bond (index) and written in outputs (name)
 MODES = ("intact", "tension", "shear", "compression")
@@ -82,20 +83,20 @@ class AgglomerateMaterial:
 
 # (key, lo, lo inclusive, hi, hi inclusive, unit as written in the file, factor to SI)
 _SPHERE_KEYS = [
-    ("density", 0.0, False, 30000.0, True, "kg/m3", 1.0),
-    ("young_modulus", 0.0, False, 2000.0, True, "GPa", 1e9),
-    ("poisson_ratio", -1.0, False, 0.5, False, "-", 1.0),
+    ("density", *in_file_unit(DENSITY, 1.0), "kg/m3", 1.0),
+    ("young_modulus", *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", 1e9),
+    ("poisson_ratio", *in_file_unit(POISSON_RATIO, 1.0), "-", 1.0),
     ("friction", 0.0, True, 10.0, True, "-", 1.0),
     ("rolling_friction", 0.0, True, 1.0, True, "-", 1.0),
     ("restitution", 0.0, False, 1.0, True, "-", 1.0),
-    ("diameter_mean", 0.0, False, 1000.0, True, "mm", 1e-3),
+    ("diameter_mean", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
     ("diameter_sd", 0.0, True, 1000.0, True, "mm", 1e-3),
-    ("diameter_min", 0.0, False, 1000.0, True, "mm", 1e-3),
-    ("diameter_max", 0.0, False, 1000.0, True, "mm", 1e-3),
+    ("diameter_min", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
+    ("diameter_max", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
 ]
 _BINDER_KEYS = [
-    ("young_modulus", 0.0, False, 2000.0, True, "GPa", 1e9),
-    ("poisson_ratio", -1.0, False, 0.5, False, "-", 1.0),
+    ("young_modulus", *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", 1e9),
+    ("poisson_ratio", *in_file_unit(POISSON_RATIO, 1.0), "-", 1.0),
     ("tensile_strength", 0.0, False, 1e5, True, "MPa", 1e6),
     ("shear_strength", 0.0, False, 1e5, True, "MPa", 1e6),
     ("compressive_strength", 0.0, False, 1e6, True, "MPa", 1e6),

@@ -9,8 +9,13 @@ Coupling layer: imports yade.
 """
 import json
 import os
+import signal
 import sys
 from pathlib import Path
+
+# Ctrl-C reaches the whole process group: the parent stops the workers itself (and they die with
+# it if it is killed: scenes._in_workers)
+signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 folder, worker, jobs = Path(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
 spec = json.loads((folder / "spec.json").read_text())

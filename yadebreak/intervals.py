@@ -1,5 +1,6 @@
 """Ranges of accepted numbers, one home for the check and its wording: the scripts' options
-(scriptargs) and attach()'s options (coupling.config) both check their values with it. Model
+(scriptargs) and attach()'s options (coupling.config) both check their values with it; the
+physical ranges of material properties below are checked in material files and scenes. Model
 layer: no YADE."""
 from __future__ import annotations
 
@@ -30,3 +31,21 @@ class Interval:
             return f"{'<' if self.hi_open else '<='} {self.hi:g}"
         return (f"in {'(' if self.lo_open else '['}{self.lo:g}, {self.hi:g}"
                 f"{')' if self.hi_open else ']'}")
+
+    def scaled(self, factor):
+        """The interval in a unit worth `factor` SI units (GPa: 1e9): its ends divided by it."""
+        return Interval(self.lo / factor, self.hi / factor, self.lo_open, self.hi_open)
+
+
+# -- physical ranges of material properties (SI) ---------------------------------------------------
+# Material files (materials.py, bonds.py) and the scene's YADE materials (coupling/scene_materials)
+# are checked against these before a run. Within them the Rayleigh time of a sphere of radius R
+# lies between 4.1e-5 R and 2.9 R s (R in m): the time step is finite and positive for any size.
+#: kg/m3: from polymer foams and wood (~100) to the densest metals (osmium, 22,600)
+DENSITY = Interval(100.0, 25000.0)
+#: Pa: from soft rubber (0.1 MPa) to diamond (1,050-1,200 GPa)
+YOUNG_MODULUS = Interval(1e5, 1.5e12)
+#: -: isotropic compressible solids (0.5, incompressible, excluded)
+POISSON_RATIO = Interval(0.0, 0.5, hi_open=True)
+#: m: particle and sphere sizes and the models' size parameters, 1 um to 1 m
+PARTICLE_SIZE = Interval(1e-6, 1.0)

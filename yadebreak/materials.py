@@ -21,6 +21,7 @@ from typing import Mapping
 import numpy as np
 
 from . import model
+from .intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS
 
 #: the materials shipped with the package
 MATERIALS_DIR = Path(__file__).resolve().parent / "data" / "materials"
@@ -217,15 +218,22 @@ class Material:
 
 
 # ------------------------------------------------------------------------------- validation
-# (key, required, lower, lower inclusive, upper, upper inclusive, unit in file, SI factor)
+def in_file_unit(interval, factor):
+    """(lower, lower inclusive, upper, upper inclusive) of a physical range (intervals.py, SI) in
+    a file's unit worth `factor` SI units (GPa: 1e9)."""
+    unit = interval.scaled(factor)
+    return unit.lo, not unit.lo_open, unit.hi, not unit.hi_open
+
+
+# (key, lower, lower inclusive, upper, upper inclusive, unit in file, SI factor)
 _ELASTIC = [
-    ("density", 100.0, True, 25000.0, True, "kg/m3", 1.0),
-    ("young_modulus", 0.0, False, 1500.0, True, "GPa", 1e9),
-    ("poisson_ratio", 0.0, True, 0.5, False, "-", 1.0),
+    ("density", *in_file_unit(DENSITY, 1.0), "kg/m3", 1.0),
+    ("young_modulus", *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", 1e9),
+    ("poisson_ratio", *in_file_unit(POISSON_RATIO, 1.0), "-", 1.0),
 ]
 _TAVARES = [
     ("e_inf", 0.0, False, math.inf, False, "J/kg", 1.0),
-    ("d0", 0.0, False, math.inf, False, "mm", 1e-3),
+    ("d0", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
     ("phi", 0.0, True, 10.0, True, "-", 1.0),
     ("sigma", 0.0, False, 10.0, True, "-", 1.0),
     ("emax_ratio", 1.0, False, math.inf, False, "-", 1.0),
@@ -236,7 +244,7 @@ _TAVARES = [
 ]
 _AB_T10 = [
     ("e_min_ref", 0.0, True, math.inf, False, "J/kg", 1.0),
-    ("size_ref", 0.0, False, math.inf, False, "mm", 1e-3),
+    ("size_ref", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
     ("selection", 0.0, False, math.inf, False, "kg/J", 1.0),
     ("t10_max", 0.0, False, 100.0, True, "%", 1.0),
 ]
@@ -283,7 +291,7 @@ def _number(table, key, where, problems, lo, lo_inc, hi, hi_inc, unit, required=
     ok_hi = value <= hi if hi_inc else value < hi
     if not (math.isfinite(value) and ok_lo and ok_hi):
         problems.append(f"{where}.{key} = {value:g} {unit} is out of range: accepted "
-                        f"{_range_text(lo, lo_inc, hi, hi_inc)}")
+                        f"{_range_text(lo, lo_inc, hi, hi_inc)}{'' if unit == '-' else ' ' + unit}")
         return None
     return value
 
@@ -390,8 +398,9 @@ def _parse_breakage(doc, values, problems):
                     default=defaults.get(key))
         values[key] = None if v is None else v * factor
     if model_name == "tavares":
-        dev = _number(breakage, "device_stiffness", "breakage", problems, 0.0, False, 1500.0,
-                      True, "GPa", required=False, default=model.DEVICE_STIFFNESS_STEEL / 1e9)
+        dev = _number(breakage, "device_stiffness", "breakage", problems,
+                      *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", required=False,
+                      default=model.DEVICE_STIFFNESS_STEEL / 1e9)
         values["device_stiffness"] = None if dev is None else dev * 1e9
     beta_source = breakage.get("beta_source", "material")
     if beta_source not in ("material", "table1"):

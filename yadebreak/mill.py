@@ -22,8 +22,9 @@ from . import coupling, milling, paraview, scenes
 from .coupling._yade import O, utils, wrapper as _w
 from .coupling.stepping import smallest_rayleigh_time
 from .scriptargs import (ScriptError, check_not_finished, check_resume_arguments, mark_finished,
-                         mark_started, partial_outputs_on_failure, progress, read_period_value,
-                         resume_arguments, time_left)
+                         mark_started, partial_outputs_on_failure, progress, read_checkpoint,
+                         read_period_value, resume_arguments, run_wall_time, stop_point,
+                         stop_points, time_left, write_atomic)
 
 PACKING = 0.6                    # solid fraction of a settled charge (bulk volume -> solid volume)
 SETTLE_TIME = 0.25               # s of settling under gravity, drum still, before the engine
@@ -251,9 +252,11 @@ def _start(args, out, say):
     checkpoint = out / "checkpoint.yade.gz"
     if getattr(args, "resume", False):
         check_not_finished(out, args)
-        brk, data = coupling.load_checkpoint(checkpoint)
+        brk, data = read_checkpoint(checkpoint, lambda path: _loaded(*coupling.load_checkpoint(
+            path)))
         check_resume_arguments(data["arguments"], args, checkpoint)
         say(f"resumed from {checkpoint} at t = {mill_time(data['info']):.3f} s")
+        data["loop"]["wall_before_s"] = data["loop"].get("wall_s", 0.0)   # earlier invocations
         return brk, data["info"], data["loop"]
     mark_started(out)
     brk, info = mill_scene(args, _options(args, out))
@@ -268,6 +271,14 @@ def _start(args, out, say):
     return brk, info, loop
 
 
+def _loaded(brk, data):
+    """A checkpoint's state, its parts checked (a damaged one fails here, before the run)."""
+    for part in ("arguments", "info", "loop"):
+        if not isinstance(data.get(part), dict):
+            raise ValueError(f"its state has no {part!r}")
+    return brk, data
+
+
 def run(args, quiet=False):
     """Build, run and report one mill. Returns (controller, summary dict)."""
     check_geometry(args)                          # before anything is written
@@ -275,20 +286,25 @@ def run(args, quiet=False):
     out.mkdir(parents=True, exist_ok=True)
     start = time.time()
     say = (lambda m: None) if quiet else progress
-    brk, info, loop = _start(args, out, say)
-    frames = paraview.series(out / "paraview", brk, args.vtk_interval,
-                             resume=getattr(args, "resume", False))
+    # SIGINT, SIGTERM from here on: the run ends at its loop's next stop_point, checkpointed
+    with stop_points():
+        brk, info, loop = _start(args, out, say)
+        frames = paraview.series(out / "paraview", brk, args.vtk_interval,
+                                 resume=getattr(args, "resume", False))
 
-    def partial(end_reason, end_message):
-        _report(brk, info, loop, args, out, time.time() - start, end_reason, end_message)
+        def runtime():                # s: the whole run's, over its invocations (to checkpoints)
+            return run_wall_time(loop, start)
 
-    with partial_outputs_on_failure(partial):
-        ended = _mill(brk, info, loop, args, out, start, say, frames)
+        def partial(end_reason, end_message):
+            _report(brk, info, loop, args, out, runtime(), end_reason, end_message)
+
+        with partial_outputs_on_failure(partial):
+            ended = _mill(brk, info, loop, args, out, start, say, frames)
     if ended is None:
         return brk, None
     brk.finish()
     frames.close()
-    summary = _report(brk, info, loop, args, out, time.time() - start, ended, "")
+    summary = _report(brk, info, loop, args, out, runtime(), ended, "")
     mark_finished(out, args)
     (out / "checkpoint.yade.gz").unlink(missing_ok=True)
     say(f"done in {summary['runtime_s']:.0f} s: {summary['breakage_events']} breakages, broken "
@@ -313,9 +329,9 @@ def _mill(brk, info, loop, args, out, start, say, frames):
         frames()
         now = time.time()
         if args.checkpoint_every >= 0 and now - last_checkpoint >= args.checkpoint_every:
-            coupling.save_checkpoint(out / "checkpoint.yade.gz", {
-                "loop": loop, "info": info, "arguments": resume_arguments(args)})
+            _checkpoint(out, info, loop, args, start)
             last_checkpoint = now
+        stop_point(lambda: _checkpoint(out, info, loop, args, start))    # SIGINT, SIGTERM
         if args.stop_after and now_s >= args.stop_after:
             return None
         if now - last_report > 10.0:
@@ -325,6 +341,14 @@ def _mill(brk, info, loop, args, out, start, say, frames):
             last_report = now
     _sample(brk, info, loop, args)
     return "finished"
+
+
+def _checkpoint(out, info, loop, args, start):
+    """The scene and the loop's state, with the run's wall time so far (this invocation began
+    at `start`): --resume 1 goes on from it."""
+    loop["wall_s"] = run_wall_time(loop, start)
+    coupling.save_checkpoint(out / "checkpoint.yade.gz", {
+        "loop": loop, "info": info, "arguments": resume_arguments(args)})
 
 
 def _report(brk, info, loop, args, out, runtime, end_reason, end_message):
@@ -378,7 +402,7 @@ def _report(brk, info, loop, args, out, runtime, end_reason, end_message):
         "final_dt": O.dt, "runtime_s": runtime,
         "throughput_s_per_hour": 3600.0 * mill_time(info) / runtime if runtime > 0 else None,
         "end_reason": end_reason, "end_message": end_message}
-    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    write_atomic(out / "summary.json", json.dumps(summary, indent=2))
     sieves = np.array(loop["sieves"])
     with open(out / "size_distribution.csv", "w", newline="") as f:
         w = csv.writer(f)

@@ -84,6 +84,26 @@ def fracture_energy_cdf(energy, e50, sigma, emax_ratio):
     return p[()] if p.ndim == 0 else p
 
 
+def fracture_energy_logpdf(energy, e50, sigma, emax_ratio):
+    """Eqs. 1-2 differentiated: ln p(E), the log density (ln of 1/(J/kg)) of specific fracture energy.
+
+    p(E) = phi(z) / sigma * d ln E*/dE, z = (ln E* - ln E50) / sigma, d ln E*/dE = Emax / (E (Emax - E)).
+    -inf outside 0 < E < Emax. The likelihood of a measured fracture energy (calibration).
+    """
+    # plain broadcasting (no broadcast_arrays): a likelihood calls this thousands of times
+    energy = np.asarray(energy, dtype=float)
+    emax = np.asarray(e50, dtype=float) * emax_ratio
+    inside = (energy > 0.0) & (energy < emax)
+    e_in = np.where(inside, energy, 0.5 * emax)
+    log_e = np.log(e_in)
+    log_e_star = log_e - np.log1p(-e_in / emax)
+    z = (log_e_star - np.log(e50)) / sigma
+    # ln(1/E + 1/(Emax - E)) = ln E* - 2 ln E
+    out = np.where(inside, -0.5 * z * z - np.log(sigma * math.sqrt(2.0 * math.pi))
+                   + log_e_star - 2.0 * log_e, -np.inf)
+    return out[()] if out.ndim == 0 else out
+
+
 def fracture_energy_ppf(u, e50, sigma, emax_ratio):
     """Inverse of Eqs. 1-2: the specific fracture energy (J/kg) at cumulative probability u.
 
@@ -158,10 +178,15 @@ def damage(ratio, gamma):
             slope = 5.0 / (2.0 * g) - 5.0 * d / (2.0 * g + 5.0 - 5.0 * d)
             with np.errstate(divide="ignore", invalid="ignore"):
                 y_new = y - f / slope
-            outside = ~np.isfinite(y_new) | (y_new <= lo) | (y_new >= hi)
+            # the bracket's ends are earlier iterates: a converged Newton step lands on one, so
+            # only a step beyond them is outside (else bisection would walk away from the root)
+            outside = ~np.isfinite(y_new) | (y_new < lo) | (y_new > hi)
             y_new = np.where(outside, 0.5 * (lo + hi), y_new)
-            done = np.abs(y_new - y) <= 1e-15 * np.maximum(1.0, np.abs(y))
-            y = y_new
+            # converged: the step, or the residual, is at round-off (else a few ratios would
+            # bounce between the bracket's ends for the full 100 iterations)
+            done = ((np.abs(y_new - y) <= 1e-15 * np.maximum(1.0, np.abs(y)))
+                    | (np.abs(f) <= 1e-14 * np.maximum(1.0, np.abs(log_r))))
+            y = np.where(np.abs(f) <= 1e-14 * np.maximum(1.0, np.abs(log_r)), y, y_new)
             if np.all(done):
                 break
         out[active] = np.minimum(np.exp(y), np.nextafter(1.0, 0.0))
@@ -423,17 +448,29 @@ def repeated_impact_broken_fraction(absorbed_energy, e50, sigma, emax_ratio, gam
     taken at evenly spaced quantiles, a deterministic quadrature) is weakened after every impact
     it survives (Eqs. 5-6); it breaks at the first impact whose energy exceeds it.
     Returns an array of length `impacts`.
+    The survivors' energies stay in the order of their quantiles (Eqs. 5-6 weaken a stronger
+    particle to a still stronger one), so the fraction broken at impact k is the quantile where the
+    survivors' energies cross the impact's: interpolated between quadrature points, it is a
+    continuous function of gamma and the distribution's parameters (what a likelihood needs).
     """
     u = (np.arange(quantiles) + 0.5) / quantiles
     energy = fracture_energy_ppf(u, e50, sigma, emax_ratio)
-    broken = np.zeros(quantiles, dtype=bool)
+    alive = np.ones(quantiles, dtype=bool)
     out = np.empty(impacts)
     for k in range(impacts):
-        now = ~broken & (absorbed_energy > energy)
-        broken |= now
-        alive = ~broken
+        e_alive, u_alive = energy[alive], u[alive]
+        if e_alive.size == 0:
+            out[k:] = 1.0
+            break
+        if absorbed_energy <= e_alive[0]:       # nobody new breaks
+            out[k] = out[k - 1] if k else 0.0
+        elif absorbed_energy >= e_alive[-1]:
+            out[k:] = 1.0
+            break
+        else:
+            out[k] = float(np.interp(absorbed_energy, e_alive, u_alive))
+        alive &= energy > absorbed_energy
         energy[alive] = weakened_fracture_energy(energy[alive], absorbed_energy / energy[alive], gamma)
-        out[k] = broken.mean()
     return out
 
 

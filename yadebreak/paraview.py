@@ -19,7 +19,6 @@ Coupling layer: imports yade.
 from __future__ import annotations
 
 import math
-import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -27,6 +26,7 @@ import numpy as np
 
 from .coupling._yade import O, wrapper
 from .coupling.state import NONE
+from .scriptargs import write_atomic
 
 #: frames over a run's planned simulated time when no interval is given (bed.run: max_time / 20)
 DEFAULT_FRAMES = 20
@@ -105,11 +105,11 @@ class ParaviewSeries:
     def write_frame(self):
         k = len(self.frames)
         spheres = f"spheres_{k:04d}.vtp"
-        _write_atomic(self.folder / spheres, self._spheres_vtp())
+        write_atomic(self.folder / spheres, self._spheres_vtp())
         surfaces = self._surfaces_file()
         self.frames.append((float(O.time), spheres, surfaces))
-        _write_atomic(self.folder / "spheres.pvd", _pvd([(t, s) for t, s, _ in self.frames]))
-        _write_atomic(self.folder / "surfaces.pvd", _pvd([(t, s) for t, _, s in self.frames]))
+        write_atomic(self.folder / "spheres.pvd", _pvd([(t, s) for t, s, _ in self.frames]))
+        write_atomic(self.folder / "surfaces.pvd", _pvd([(t, s) for t, _, s in self.frames]))
 
     # -- spheres ---------------------------------------------------------------------------------
     def _spheres_vtp(self):
@@ -154,16 +154,15 @@ class ParaviewSeries:
     # -- walls and facets ----------------------------------------------------------------------
     def _surfaces_file(self):
         """The file of the walls and facets as they are now: the last one if nothing changed."""
-        points, polys, ids = self._surface_geometry()
+        points, polys, ids = geometry = self._surface_geometry()
         if self._surfaces is not None:
             (last_points, last_polys, last_ids), name = self._surfaces
             if (last_polys == polys and np.array_equal(last_ids, ids)
                     and np.array_equal(last_points, points)):
                 return name
         name = f"surfaces_{len({s for _, _, s in self.frames}):04d}.vtp"
-        _write_atomic(self.folder / name, _polydata(points, [("id", ids, "Int64")], "CellData",
-                                                    polys))
-        self._surfaces = ((points, polys, ids), name)
+        write_atomic(self.folder / name, _surfaces_vtp(geometry))
+        self._surfaces = (geometry, name)
         return name
 
     def _surface_geometry(self):
@@ -220,6 +219,11 @@ class ParaviewSeries:
         spheres, surfaces = (_read_pvd(self.folder / name) for name in ("spheres.pvd", "surfaces.pvd"))
         self.frames = [(t, s, f) for (t, s), (_, f) in zip(spheres, surfaces) if t <= now]
         self._remove_files(len(self.frames), {f for _, _, f in self.frames})
+        if self.frames:                   # surfaces unchanged since: that file goes on
+            last = self.folder / self.frames[-1][2]
+            geometry = self._surface_geometry()
+            if last.is_file() and last.read_text() == _surfaces_vtp(geometry):
+                self._surfaces = (geometry, last.name)
 
     def _remove_files(self, first_kept_out, surfaces_kept=()):
         """Frame files of an earlier run not in this series: spheres_k for k >= first_kept_out and
@@ -271,6 +275,11 @@ def _polydata(points, arrays, where, polys=None):
             '</Piece>\n</PolyData>\n</VTKFile>\n')
 
 
+def _surfaces_vtp(geometry):
+    points, polys, ids = geometry
+    return _polydata(points, [("id", ids, "Int64")], "CellData", polys)
+
+
 def _pvd(frames):
     """The collection index: one DataSet per frame, timestep in seconds of simulated time."""
     entries = "".join(f'<DataSet timestep="{t!r}" group="" part="0" file="{name}"/>\n'
@@ -286,8 +295,3 @@ def _read_pvd(path):
     return [(float(d.get("timestep")), d.get("file"))
             for d in ET.parse(path).getroot().iter("DataSet")]
 
-
-def _write_atomic(path, text):
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)

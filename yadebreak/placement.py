@@ -98,6 +98,23 @@ def fragment_velocities(centers, masses, parent_center, velocity, angular_veloci
     return vel + correction
 
 
+def spin_scale(centers, masses, radii, parent_center, parent_inertia, angular_velocity):
+    """The factor (<= 1) on the parent's angular velocity w that the fragments take, so that their
+    rotational energy, spin plus the rigid field w x (c_i - c_cm) about their centre of mass,
+    is at most the parent's I w^2 / 2 (fragments far from the centre would otherwise carry more:
+    a replacement must not create energy). 1 when the field holds no more, or w = 0. SI units."""
+    omega = np.asarray(angular_velocity, dtype=float)
+    masses = np.asarray(masses, dtype=float)
+    parent = 0.5 * parent_inertia * (omega @ omega)
+    if parent == 0.0:
+        return 1.0
+    orbit = np.cross(omega, np.asarray(centers, dtype=float) - np.asarray(parent_center, float))
+    orbit -= (masses @ orbit) / masses.sum()
+    held = 0.5 * (masses @ (orbit * orbit).sum(axis=1)
+                  + (0.4 * masses * np.asarray(radii, dtype=float) ** 2).sum() * (omega @ omega))
+    return 1.0 if held <= parent else float(np.sqrt(parent / held))
+
+
 def fragment_masses(parent_mass, fragment_radii):
     """Masses proportional to r^3 summing to the parent's mass (exact to round-off)."""
     vol = np.asarray(fragment_radii, dtype=float) ** 3
@@ -130,6 +147,20 @@ def hertz_loading_time(radius, density, young, poisson, speed):
     e_star = np.asarray(young, dtype=float) / (1.0 - np.asarray(poisson, dtype=float) ** 2)
     speed = np.maximum(np.asarray(speed, dtype=float), 1e-12)
     return 0.5 * 2.868 * (mass ** 2 / (radius * e_star ** 2 * speed)) ** 0.2
+
+
+def hertz_onset_time(radius, density, young, poisson, speed, specific_energy):
+    """Time (s) after first touch at which a sphere hitting a rigid wall at `speed` (m/s) has
+    taken `specific_energy` (J/kg) through the contact, early in the loading (overlap = speed x
+    time): W / m = 0.4 kno (v t)^2.5 / m with kno = 4/3 E* sqrt(R), i.e.
+    e = 2 E* / (5 pi rho) (v t / R)^2.5, E* = Y / (1 - nu^2). A softer partner or a slower
+    closing takes longer, so this is the shortest time in which a fresh contact can bring a
+    sphere of this size that much energy. SI units."""
+    e_star = np.asarray(young, dtype=float) / (1.0 - np.asarray(poisson, dtype=float) ** 2)
+    speed = np.maximum(np.asarray(speed, dtype=float), 1e-12)
+    scale = 5.0 * np.pi * np.asarray(density, dtype=float) / (2.0 * e_star)
+    return np.asarray(radius, dtype=float) / speed * (np.asarray(specific_energy, float)
+                                                      * scale) ** 0.4
 
 
 def pouring_column(count, radius, holder_radius, rng, gap=0.1):

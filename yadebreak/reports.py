@@ -199,6 +199,33 @@ def breakage_result_of(tally, material, specific_energy, partner):
     return result
 
 
+def check_breakage_result(result, material, size, specific_energy, partner, particles):
+    """Raise ValueError (saying what) unless `result` is one breakage_result_of could have given
+    for `particles` particles of `material` of `size` (m) at `specific_energy` (J/kg) on
+    `partner`: a result read back from a file (--resume 1) damaged, edited or of another run."""
+    def number(name, lo=-np.inf, hi=np.inf):
+        value = result.get(name)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                or not lo <= value <= hi:
+            raise ValueError(f"{name} = {value!r}: must be a number in [{lo:g}, {hi:g}]")
+        return value
+    if number("specific_energy") != specific_energy:
+        raise ValueError(f"specific_energy = {result['specific_energy']!r}, not "
+                         f"{specific_energy!r}")
+    if result.get("particles") != particles:
+        raise ValueError(f"particles = {result.get('particles')!r}, not {particles}")
+    broken = number("broken_fraction", 0.0, 1.0) * particles
+    if abs(broken - round(broken)) > 1e-9 * particles:
+        raise ValueError(f"broken_fraction = {result['broken_fraction']!r} is not a count of "
+                         f"{particles} particles")
+    p_model = float(material.breakage_probability(specific_energy, size, partner=partner))
+    if not np.isclose(number("model_probability", 0.0, 1.0), p_model, rtol=1e-9, atol=0.0):
+        raise ValueError(f"model_probability = {result['model_probability']!r}, the model gives "
+                         f"{p_model!r}")
+    if round(broken) and result.get("t10_simulated") is not None:
+        number("t10_simulated", 0.0, 100.0)
+
+
 def result_line(result):
     """One progress line for an energy: broken fraction and t10 against the model."""
     line = (f"{result['specific_energy']:g} J/kg: {100 * result['broken_fraction']:.1f} % broken "

@@ -14,6 +14,7 @@ from .coupling import add_materials, attach, run_steps
 from .coupling.rolling import rolling_engine
 from .coupling.scene_materials import rolling_friction
 from .coupling._yade import O, utils, wrapper as _w
+from .scriptargs import stop_point, stop_points
 
 
 def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False, rolling=None):
@@ -144,8 +145,10 @@ def _in_workers(spec, jobs, event_log, on_scene):
     (folder / "spec.json").write_text(json.dumps(spec))
     worker = str(Path(__file__).resolve().parent / "impact_worker.py")
     errors = [open(folder / f"{j}.err", "w") for j in range(jobs)]
+    from .sweep import _die_with_parent       # a parent killed (even -9) takes them along
     procs = [subprocess.Popen(["yade", "-n", "-x", worker, str(folder), str(j), str(jobs)],
-                              stdout=subprocess.DEVNULL, stderr=errors[j]) for j in range(jobs)]
+                              stdout=subprocess.DEVNULL, stderr=errors[j],
+                              preexec_fn=_die_with_parent) for j in range(jobs)]
     try:
         reported = 0
         while True:
@@ -212,12 +215,14 @@ def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None):
     follow = brk is not None and speed > 0.0
     quiet = 5.0 * _loading_time(fired[0], speed) if follow else None
     done_steps = 0
-    while done_steps < max_steps:
-        run_steps(check_every)
-        done_steps += check_every
-        if all(_left(i) for i in ids) and (not follow or _all_away(0.1 * speed)
-                                           or O.time - _last_breakage(brk) > quiet):
-            break
+    with stop_points():                  # a script's SIGINT, SIGTERM: stop between the checks
+        while done_steps < max_steps:
+            run_steps(check_every)
+            done_steps += check_every
+            stop_point()
+            if all(_left(i) for i in ids) and (not follow or _all_away(0.1 * speed)
+                                               or O.time - _last_breakage(brk) > quiet):
+                break
     return done_steps
 
 

@@ -73,6 +73,10 @@ def read_table(path):
         described_by = [h.rstrip("!") for h in headings if h.endswith("!") and
                         not h.startswith("!")] or [h.rstrip("!") for h in headings]
         headings = [h[:-1] if h.endswith("!") and not h.startswith("!") else h for h in headings]
+    for k, head in enumerate(headings):
+        if head in headings[:k]:          # yade-batch would take the last value: refused
+            raise SweepError(f"table {path}:{usable[0]}: column {k + 1}, {head!r}, repeats column "
+                             f"{headings.index(head) + 1} (each parameter once)")
     lines, previous, seen = [], None, set()
     for number in usable[1:]:
         cells = text[number].split()

@@ -4,9 +4,9 @@ from ..yadepath import ensure_yade_importable
 ensure_yade_importable()
 
 import yade.wrapper as wrapper  # noqa: E402
-from yade import O, utils  # noqa: E402
+from yade import O, Vector3, utils  # noqa: E402
 
-__all__ = ["O", "find_engine", "utils", "wrapper"]
+__all__ = ["O", "Vector3", "find_engine", "utils", "wrapper"]
 
 
 def find_engine(label):

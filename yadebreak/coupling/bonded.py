@@ -5,6 +5,8 @@ force alone.
     scene = agglomerate_scene(material, packing, seed=1)          # after O.reset()
     watch = scene.watch                                           # a BondWatch, in O.engines
     O.run(1000, True); watch.broken_count(), watch.damage_ratios()
+    renew_contacts(); save_checkpoint(path, scene, script_state)  # later, perhaps elsewhere:
+    scene, script_state = load_checkpoint(path)                   # goes on exactly as it would
 
 Each bond is a YADE interaction whose physics is a CohFrictPhys given the beam's stiffnesses of
 Eq. B6 (axial, shear, bending, twist), made stress-free where it is built (`unp`: the sphere gap),
@@ -12,9 +14,15 @@ with adhesions YADE can never reach: YADE integrates the beam, BondWatch breaks 
 interaction is erased; if the spheres touch again YADE makes a Hertz-Mindlin contact (the only
 physics functor of the scene), with damping and rolling friction. A contact is bonded or not,
 never both.
+
+The BondWatch's state (the bonds as built, their strengths, which broke when and how) lives in
+Python, which O.save does not store: save_checkpoint keeps it in O.tags as JSON (floats written
+exactly), and the scene's interactions keep the intact beams; load_checkpoint (or the first step
+after an O.load of such a file) restores the watch from both.
 """
 from __future__ import annotations
 
+import json
 import math
 import time
 from dataclasses import dataclass
@@ -22,15 +30,24 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import bonds, placement
+from ..intervals import Interval
+from . import engine
 from ._yade import O, utils, wrapper as _w
+from .config import AttachError
 
 #: stresses at or above this fraction of a bond's strength are counted (the document's Fig. 18)
 WATCH_LEVEL = 0.8
 #: the PyRunner's label, and the key of its BondWatch
 LABEL = "bond_watch"
 _WATCHES: dict = {}
+#: O.tags key of the BondWatch's state and the scene's ids (written by save_checkpoint)
+_TAG = "yadebreak_bonds"
 #: an adhesion YADE's cohesive law never reaches (N, N m): bonds break here, not there
 NEVER = 1e30
+#: the accepted time steps (s): the rolling stiffness divides by dt^2, which must stay a float
+TIME_STEP = Interval(1e-150, math.inf)
+#: YADE counts steps in a signed 64-bit integer
+MAX_STEPS = 2**63 - 1
 
 
 @dataclass
@@ -47,12 +64,14 @@ class AgglomerateScene:
 
 
 def agglomerate_scene(material, packing, seed, speed=4.0, gap=1e-5, gravity=9.81,
-                      time_step_fraction=0.2, check_period=1):
+                      time_step_fraction=0.2, check_period=1, duration=0.0):
     """The agglomerate of `packing` (a bonds.Packing, centred at the origin) bonded by
     `material` (a bonds.AgglomerateMaterial) in the current, empty YADE scene, its lowest point
     `gap` (m) above a rigid steel plane z = 0 and moving down at `speed` (m/s). Bond strengths
     are drawn from numpy's Generator seeded by `seed`. O.dt = time_step_fraction x the shorter of
-    the bonds' time scale (Eq. B11) and the smallest sphere's Rayleigh time."""
+    the bonds' time scale (Eq. B11) and the smallest sphere's Rayleigh time; AttachError (one
+    line) if that step is out of TIME_STEP or the steps to the touch and through `duration` (s)
+    after it exceed YADE's step counter."""
     sp, binder = material.spheres, material.binder
     rng = np.random.default_rng(seed)
     sphere_mat = O.materials.append(_w.FrictMat(
@@ -76,7 +95,16 @@ def agglomerate_scene(material, packing, seed, speed=4.0, gap=1e-5, gravity=9.81
     O.engines = bonded_engines(sp, gravity)
     watch, time_scale = attach_bonds(ids, pairs, lengths, packing.radii, binder, rng, target,
                                      check_period)
-    O.dt = time_step_fraction * min(time_scale, rayleigh)
+    dt = time_step_fraction * min(time_scale, rayleigh)
+    steps = (gap / speed + duration) / dt if dt > 0 else math.inf
+    if dt not in TIME_STEP or not steps <= MAX_STEPS:
+        raise AttachError(
+            f"time_step_fraction = {time_step_fraction:g}: the time step {dt:.3g} s (that fraction "
+            f"of the shorter of the bonds' time scale, {time_scale:.3g} s, and the smallest "
+            f"sphere's Rayleigh time, {rayleigh:.3g} s, of {material.source}) needs {steps:.3g} "
+            f"steps for {duration:g} s after the touch: accepted a time step {TIME_STEP} s and "
+            f"at most {MAX_STEPS:.3g} steps (YADE's step counter)")
+    O.dt = dt
     set_rolling_stiffness(inertia.min())
     return AgglomerateScene(ids, target, watch, masses, time_scale, rayleigh)
 
@@ -122,6 +150,7 @@ def attach_bonds(ids, pairs, lengths, radii, binder, rng, target_id=None, check_
     time_scale = bonds.bond_time_scale(masses, 0.4 * masses * radii**2, pairs,
                                        network.stiffness, network.lever_a, network.lever_b)
     watch = BondWatch(network, target_id, check_period=check_period)
+    watch.last_iter = max(O.iter, 1) - 1    # YADE first runs a PyRunner at iteration 1 or later
     _WATCHES[LABEL] = watch
     # updateGlobals=False: YADE would otherwise copy the caller's locals into __main__ each call
     O.engines = O.engines + [_w.PyRunner(
@@ -131,13 +160,71 @@ def attach_bonds(ids, pairs, lengths, radii, binder, rng, target_id=None, check_
 
 
 def on_step(label):
-    """Called by the PyRunner after Newton's step."""
+    """Called by the PyRunner after Newton's step. A watch that did not see the previous step
+    (the scene was loaded, or went back in time) is restored from the scene."""
     watch = _WATCHES.get(label)
-    if watch is None:
-        raise RuntimeError(f"no BondWatch {label!r} in this process: a bonded scene's bonds are "
-                           "watched by the process that built it (saving and loading one is not "
-                           "supported)")
+    if watch is None or O.iter != watch.last_iter + 1:
+        watch = restore_scene().watch
+    watch.last_iter = O.iter
     watch()
+
+
+def save_checkpoint(path, scene, script_state):
+    """engine.save_checkpoint (the scene to `path` atomically, with a script's loop state) with
+    the BondWatch of `scene` (an AgglomerateScene) kept in O.tags."""
+    O.tags[_TAG] = json.dumps({
+        "iter": O.iter, "label": LABEL, "watch": scene.watch.to_dict(),
+        "sphere_ids": scene.sphere_ids.tolist(), "target_id": int(scene.target_id),
+        "time_scale": scene.time_scale, "rayleigh_time": scene.rayleigh_time})
+    engine.save_checkpoint(path, script_state)
+
+
+def renew_contacts():
+    """Put the scene in the state an O.load of it gives, so that a run resumed from a checkpoint
+    saved right after this goes on exactly as the run that saved it. YADE's save keeps the
+    interactions but not its collider's candidate pairs (non-real interactions): a loaded scene's
+    collider finds them again in its own order, contacts made later sit elsewhere in the list of
+    interactions, and the forces on their spheres are summed in another order (last-bit
+    differences that the flow amplifies). Here the candidates are dropped and the collider
+    replaced by a fresh one with the same settings, as a load does; called at the same steps of
+    every run, resumed or not. Cost: one full sort of the bounds (0.1 s at 4,104 spheres)."""
+    O.interactions.eraseNonReal()
+    engines = list(O.engines)
+    k = next(i for i, e in enumerate(engines) if isinstance(e, _w.InsertionSortCollider))
+    old = engines[k]
+    fresh = _w.InsertionSortCollider(list(old.boundDispatcher.functors))
+    for key, value in old.dict().items():
+        if key not in ("boundDispatcher", "newton", "numReinit"):   # set by YADE, or read-only
+            setattr(fresh, key, value)
+    engines[k] = fresh
+    O.engines = engines
+
+
+def load_checkpoint(path):
+    """O.load a checkpoint written by save_checkpoint: (AgglomerateScene, script state)."""
+    _, script_state = engine.load_checkpoint(path, label=None)
+    return restore_scene(), script_state
+
+
+def restore_scene():
+    """The AgglomerateScene of a scene loaded from save_checkpoint's file, its BondWatch
+    registered again (reading the intact bonds' interactions). Raises RuntimeError if the scene
+    has no BondWatch state or ran on after it was stored (an O.save does not store it)."""
+    if _TAG not in O.tags.keys() or not O.tags[_TAG]:
+        raise RuntimeError("this bonded scene has no BondWatch state: its bonds are watched by "
+                           "the process that built it, or saved with bonded.save_checkpoint")
+    data = json.loads(O.tags[_TAG])
+    if data["iter"] != O.iter:
+        raise RuntimeError(f"the BondWatch's state in this scene was stored at step "
+                           f"{data['iter']} and the scene is at step {O.iter}: O.save does not "
+                           "store it; save bonded scenes with bonded.save_checkpoint")
+    watch = BondWatch.from_dict(data["watch"])
+    watch.last_iter = O.iter - 1
+    _WATCHES[data["label"]] = watch
+    ids = np.array(data["sphere_ids"], np.int64)
+    masses = np.array([O.bodies[int(i)].state.mass for i in ids])
+    return AgglomerateScene(ids, data["target_id"], watch, masses, data["time_scale"],
+                            data["rayleigh_time"])
 
 
 @dataclass
@@ -191,6 +278,35 @@ class BondNetwork:
         return cls(len(ids), a, b, pairs, radius, lengths, lever_a, lever_b, stiffness, unp,
                    strengths, geoms, physs)
 
+    _ARRAYS = ("a", "b", "pairs", "radius", "length", "lever_a", "lever_b", "unp")
+
+    def to_dict(self):
+        """The bonds as built, JSON-able (floats exact: JSON writes their shortest repr)."""
+        data = {k: getattr(self, k).tolist() for k in self._ARRAYS}
+        data["stiffness"] = {k: v.tolist() for k, v in vars(self.stiffness).items()}
+        data["strengths"] = [s.tolist() for s in self.strengths]
+        data["n_spheres"] = self.n_spheres
+        return data
+
+    @classmethod
+    def from_dict(cls, data, intact):
+        """The network of to_dict, its intact bonds (a boolean mask) read again from YADE's
+        interactions (broken bonds have none: None)."""
+        arrays = {k: np.array(data[k]) for k in cls._ARRAYS}
+        geoms, physs = [None] * len(arrays["a"]), [None] * len(arrays["a"])
+        for k in np.flatnonzero(intact):
+            a, b = int(arrays["a"][k]), int(arrays["b"][k])
+            inter = O.interactions[a, b] if O.interactions.has(a, b) else None
+            if inter is None or not isinstance(inter.phys, _w.CohFrictPhys):
+                raise RuntimeError(f"bond {k} (bodies {a}-{b}) is intact in the BondWatch's "
+                                   "state but has no bond in the scene: the state and the scene "
+                                   "do not match")
+            geoms[k], physs[k] = inter.geom, inter.phys
+        stiffness = bonds.BeamStiffness(**{k: np.array(v) for k, v in data["stiffness"].items()})
+        return cls(int(data["n_spheres"]), stiffness=stiffness,
+                   strengths=tuple(np.array(s) for s in data["strengths"]), geoms=geoms,
+                   physs=physs, **arrays)
+
 
 class BondWatch:
     """Called by a PyRunner every step: from the first touch of the target on, every
@@ -218,6 +334,32 @@ class BondWatch:
         self.bonds_read = 0
         self.seconds = 0.0                           # wall time spent in check() (cost report)
         self.on_failure = None                       # callable(rows, modes, time), if set
+        self.last_iter = -1                          # O.iter of the last call (on_step)
+
+    _STATE = ("touch_time", "checks", "bonds_read", "seconds", "check_period", "target_id")
+
+    def to_dict(self):
+        """The watch's state, JSON-able: the network, each bond's mode and failure time."""
+        data = {k: getattr(self, k) for k in self._STATE}
+        data.update(network=self.net.to_dict(), mode=self.mode.tolist(),
+                    failed_at=self.failed_at.tolist(), above=self.above.tolist())
+        return data
+
+    @classmethod
+    def from_dict(cls, data):
+        """The watch of to_dict, the intact bonds read from the scene's interactions."""
+        mode = np.array(data["mode"], np.int8)
+        watch = cls(BondNetwork.from_dict(data["network"], mode == bonds.INTACT),
+                    data["target_id"], data["check_period"])
+        watch.mode, watch.failed_at = mode, np.array(data["failed_at"], float)
+        watch.alive = np.flatnonzero(mode == bonds.INTACT)     # as _break keeps it: ascending
+        watch._geoms = [watch.net.geoms[r] for r in watch.alive]
+        watch._physs = [watch.net.physs[r] for r in watch.alive]
+        watch._intact = _IntactColumns(watch.net, watch.alive)
+        watch.above = np.array(data["above"], int)
+        for k in ("touch_time", "checks", "bonds_read", "seconds"):
+            setattr(watch, k, data[k])
+        return watch
 
     # -- the per-step path --------------------------------------------------------------------
     def __call__(self):

@@ -74,7 +74,8 @@ class Controller:
         self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero",
                                       config.replacement.zeroing_tolerance)
         self.smallest = SmallestBreakable()
-        self.schedule = ReadSchedule(config.reading, label, self._smallest_breakable)
+        self.schedule = ReadSchedule(config.reading, label, self._smallest_breakable,
+                                     self._low_fracture_energy)
         self.time_step = TimeStep(config.time_step.time_step_fraction, self._warn_once)
         self.damping = FragmentDamping(config.time_step.global_damping,
                                        config.time_step.global_damping_time)
@@ -171,6 +172,12 @@ class Controller:
     def _smallest_breakable(self):
         return self.smallest.get(self._still_breakable)
 
+    def _low_fracture_energy(self, i, u):
+        """The fracture energy (J/kg) of quantile u of body i's material at its size."""
+        table = self.state.table
+        return float(self.material[table.label_of(i)].fracture_energy_ppf(
+            u, 2.0 * float(table.columns["radius"][i])))
+
     def _still_breakable(self, i):
         return i in self.state.tracked and self.state.table.columns["kind"][i] == BREAKABLE
 
@@ -247,7 +254,7 @@ class Controller:
                 progeny = self.replacer.replace(bid, t10, direction, dmin)
                 self.reader.erased(bid)
                 event.update(fragments=progeny.ids, family_t10=progeny.family_t10,
-                             fragment_speed_excess=progeny.speed_excess)
+                             fragment_speed_excess=progeny.speed_excess, **progeny.audit)
                 self._adopt(progeny.ids)
                 self.damping.add(progeny.ids)
                 self.schedule.saw_speed(max((O.bodies[i].state.vel.norm() for i in progeny.ids),

@@ -159,22 +159,39 @@ def save(path):
 
 
 def save_checkpoint(path, script_state):
-    """save() the scene to `path` with a script's loop state (a JSON-able dict), written to a
-    temporary file first so that a crash never leaves half a checkpoint."""
+    """save() the scene to `path` with a script's loop state (a JSON-able dict), whole or not at
+    all: to temporary files first, then os.replace, so that a kill or a full disk never leaves
+    half a checkpoint (the last good one stays; the temporary files are removed). A .gz path is
+    saved plain by YADE and compressed here: YADE's own gzip writer loops forever on a full disk
+    (measured, YADE 2023.02a), its plain writer raises."""
     path = Path(path)
     O.tags[_SCRIPT_TAG] = json.dumps(script_state)
-    tmp = path.with_name(path.name + ".tmp.yade.gz")
-    save(tmp)
-    os.replace(tmp, path)
+    packed = path.name.endswith(".gz")
+    plain = path.with_name(path.name + (".tmp.yade" if packed else ".tmp" + path.suffix))
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        save(plain)
+        if packed:
+            import gzip
+            import shutil
+            with open(plain, "rb") as source, gzip.open(tmp, "wb", compresslevel=1) as target:
+                shutil.copyfileobj(source, target, 1 << 20)
+            os.replace(tmp, path)
+        else:
+            os.replace(plain, path)
+    finally:
+        plain.unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
 
 
 def load_checkpoint(path, label="yadebreak"):
-    """O.load a checkpoint written by save_checkpoint; returns (controller, script state)."""
+    """O.load a checkpoint written by save_checkpoint; returns (controller, script state); label
+    None: a scene without yadebreak's engine (the bonded agglomerate), controller None."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"--resume: no checkpoint at {path}; run without --resume first")
     O.load(str(path))
-    return controller_of(label), json.loads(O.tags[_SCRIPT_TAG])
+    return None if label is None else controller_of(label), json.loads(O.tags[_SCRIPT_TAG])
 
 
 def run_steps(steps):

@@ -18,22 +18,39 @@ from .state import BREAKABLE, DUMMY, UNBREAKABLE
 class Progeny:
     """What a replacement made: fragment ids (spheres in the scene), the family's t10' (%), the
     largest fragment speed beyond the parent's rigid field (m/s), the smallest fragment radius (m,
-    None if every fragment went to the ledger)."""
+    None if every fragment went to the ledger), and the energy audit (J): kinetic and elastic
+    energy of the parent just before, of the progeny just after (see Replacer.replace)."""
 
     ids: list
     family_t10: float
     speed_excess: float
     smallest_radius: float | None
+    audit: dict
+
+
+def _elastic_energy(inter, zeroed):
+    """Elastic energy (J) a Hertz-Mindlin contact holds: 0.4 kno0 (d - d0)^2.5 in the normal
+    direction (Fn = kno0 (d - d0)^1.5, d0 its zeroed overlap, if any; none while the zeroing
+    holds it slack, kno = 0) plus |Fs|^2 / (2 ks) of the elastic shear force (the law's
+    shearForce adds the viscous part)."""
+    phys, d = inter.phys, inter.geom.penetrationDepth
+    kno0, d0 = (zeroed.kno0, zeroed.artificial) if zeroed is not None else (phys.kno, 0.0)
+    if phys.kno == 0.0:
+        kno0 = 0.0                    # a slack zeroed pair (asleep too): it makes no force
+    energy = 0.4 * kno0 * max(d - d0, 0.0) ** 2.5
+    if phys.ks > 0.0:
+        energy += 0.5 * phys.shearElastic.squaredNorm() / phys.ks
+    return energy
 
 
 def _neighbours(bid, zeroing):
-    """The parent's neighbours and its real (force-producing) overlap (m) with each."""
-    found = []
+    """The parent's neighbours (ids) and the elastic energy (J) of its contacts with them."""
+    found, energy = [], 0.0
     for inter in O.interactions.withBody(bid):
         other = inter.id2 if inter.id1 == bid else inter.id1
-        real = inter.geom.penetrationDepth - zeroing.artificial(bid, other)
-        found.append((other, max(real, 0.0)))
-    return found
+        found.append(other)
+        energy += _elastic_energy(inter, zeroing.pairs.get((min(bid, other), max(bid, other))))
+    return found, energy
 
 
 def _sphere_body(material, center, radius, mass, vel, angvel, damped):
@@ -83,15 +100,16 @@ class Replacer:
         radii = fam.relative_sizes * radius
         centers = placement.place_fragments(center, radius, radii, direction, self.rng)
         masses = placement.fragment_masses(mass, radii)
-        vel = placement.fragment_velocities(centers, masses, center, np.array(body.state.vel),
-                                            np.array(body.state.angVel))
-        angvel = body.state.angVel
-        # no fragment may leave faster than the parent's rigid field allows: |v| + 2 |w| r bounds
-        # it (v + w x (c_i - c_cm) after the momentum shift); the event records the margin
-        speed_excess = float(np.linalg.norm(vel, axis=1).max() - np.linalg.norm(body.state.vel)
-                             - 2.0 * np.linalg.norm(angvel) * radius)
+        parent_vel, parent_spin = np.array(body.state.vel), np.array(body.state.angVel)
+        # the fragments' rigid field may hold more rotational energy than the parent's spin did
+        # (fragments far from the centre): its spin is then scaled down to the parent's energy
+        spin = parent_spin * placement.spin_scale(centers, masses, radii, center,
+                                                  float(body.state.inertia[0]), parent_spin)
+        vel = placement.fragment_velocities(centers, masses, center, parent_vel, spin)
         material = body.material
-        neighbours = _neighbours(bid, self.zeroing)
+        neighbours, elastic_before = _neighbours(bid, self.zeroing)
+        kinetic_before = 0.5 * (mass * parent_vel @ parent_vel
+                                + float(body.state.inertia[0]) * parent_spin @ parent_spin)
         O.bodies.erase(bid)
         self.zeroing.drop_body(bid)
         keep = np.arange(len(radii))
@@ -100,17 +118,30 @@ class Replacer:
             for k in np.nonzero(fam.is_dummy)[0]:
                 self.ledger.add(masses[k], 2.0 * radius, t10, label, masses[k] * vel[k])
             keep = keep[~fam.is_dummy]
+        inertias = 0.4 * masses * radii ** 2
+        kinetic_after = 0.5 * float(masses @ (vel * vel).sum(axis=1)
+                                    + inertias.sum() * spin @ spin)
         radii, centers, masses, vel = radii[keep], centers[keep], masses[keep], vel[keep]
-        new = [_sphere_body(material, c, r, m, v, angvel, self.damped)
+        new = [_sphere_body(material, c, r, m, v, spin, self.damped)
                for c, r, m, v in zip(centers.tolist(), radii.tolist(), masses.tolist(),
                                      vel.tolist())]
         ids = list(O.bodies.append(new))
         self._new_rows(ids, label, fam.is_dummy[keep], radii, masses, t10, 2.0 * radius,
                        int(self.table.columns["generation"][bid]) + 1, dmin)
-        if self.options.zero_overlaps and ids:
-            self._zero(ids, centers, radii, neighbours)
+        held, elastic_after = (self._contacts(ids, centers, radii, neighbours) if ids
+                               else (np.zeros(0), 0.0))
         self.zeroing.wake()
-        return Progeny(ids, fam.t10, speed_excess, float(radii.min()) if ids else None)
+        # no fragment may leave faster than the parent's rigid field allows, |v| + 2 |w| R
+        # (v + w x (c_i - c_cm) after the momentum shift), counting the energy its contacts can
+        # still give it; the event records the margin (> 0 only with local_damping)
+        reach = np.sqrt((vel * vel).sum(axis=1) + 2.0 * held / masses) if ids else np.zeros(1)
+        speed_excess = float(reach.max() - np.linalg.norm(parent_vel)
+                             - 2.0 * np.linalg.norm(parent_spin) * radius)
+        audit = {"kinetic_energy_before": float(kinetic_before),
+                 "elastic_energy_before": float(elastic_before),
+                 "kinetic_energy_after": kinetic_after,
+                 "elastic_energy_after": elastic_after}
+        return Progeny(ids, fam.t10, speed_excess, float(radii.min()) if ids else None, audit)
 
     def _new_rows(self, ids, label, is_dummy, radii, masses, t10, parent_size, generation, dmin):
         """The fragments' state: dummy, unbreakable (its own progeny would be finer than dmin)
@@ -138,20 +169,21 @@ class Replacer:
             for name, value in extra.items():
                 c[name][ids[need]] = value
 
-    def _zero(self, ids, centers, radii, neighbours):
-        """Zero the artificial overlaps: between siblings entirely; with each neighbour of the
-        parent, the child overlapping it most keeps the parent's real overlap as real force and
-        everything beyond it is zeroed, while the other children's overlaps with that neighbour
-        are zeroed entirely (else k children would each press with the parent's overlap and
-        multiply the force the parent carried). Every overlapping pair is inherited: the reader
-        counts its work from now on."""
-        zero = self.zeroing.zero_pair
-        inherited = []
+    def _contacts(self, ids, centers, radii, neighbours):
+        """Make the fragments' contacts (with each other and with the parent's neighbours) and
+        zero their artificial overlaps: every overlap of a fresh fragment is the zero of its
+        contact, so that only later loading makes force. The energy the parent's contacts held
+        went into breaking it: had a child kept the parent's real overlap, that energy would push
+        one fragment, often a fine one near the loaded point, and throw it many times faster than
+        the impact. Every overlapping pair is inherited: the reader counts its work from now on.
+        Returns the elastic energy (J) each fragment's contacts hold (0 when zeroed, but for
+        local_damping's released share) and the energy of all those contacts (J)."""
+        zeroed = self.options.zero_overlaps
+        pairs = []
         ii, jj, overlap = placement.overlapping_pairs(centers, radii)
         for a, b, ov in zip(ii, jj, overlap):
-            zero(ids[a], ids[b], float(ov), created=False)
-            inherited.append((ids[a], ids[b]))
-        for other, real in neighbours:
+            pairs.append((ids[a], ids[b], float(ov), False))
+        for other in neighbours:
             ob = O.bodies[other]
             if ob is None:
                 continue
@@ -162,16 +194,26 @@ class Replacer:
             else:                                # walls, facets: ask YADE's own geometry
                 ov = np.array([_overlap_with(i, other) for i in ids])
                 created = True
-            touching = np.nonzero(ov > 0.0)[0]
-            if len(touching) == 0:
-                continue
-            keeper = touching[np.argmax(ov[touching])]
-            for k in touching:
-                inherited.append((ids[k], other))
-                artificial = ov[k] - real if k == keeper else ov[k]
-                if artificial > 0.0:
-                    zero(ids[k], other, float(artificial), created=created)
-        self.reader.inherit(inherited)
+            for k in np.nonzero(ov > 0.0)[0]:
+                pairs.append((ids[k], other, float(ov[k]), created))
+        for a, b, ov, created in pairs:
+            if zeroed:
+                self.zeroing.zero_pair(a, b, ov, created=created)
+            elif not created:                    # made now, as the collider would next step
+                utils.createInteraction(a, b)
+        self.reader.inherit([(a, b) for a, b, _, _ in pairs])
+        held, total = np.zeros(len(ids)), 0.0
+        if zeroed and self.zeroing.local_damping == 0.0:
+            return held, total                   # nothing held: no need to look
+        index = {i: k for k, i in enumerate(ids)}
+        for a, b, _, _ in pairs:
+            energy = _elastic_energy(O.interactions[a, b],
+                                     self.zeroing.pairs.get((min(a, b), max(a, b))))
+            total += energy
+            for i in (a, b):
+                if i in index:
+                    held[index[i]] += energy
+        return held, total
 
 
 def _overlap_with(fragment, other):

@@ -6,6 +6,7 @@ import dataclasses
 import math
 
 from .. import model
+from ..intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS
 from ..materials import Material, MaterialError, load_material
 from ._yade import O, wrapper
 from .config import AttachError
@@ -17,6 +18,23 @@ def _frict_material(mat: Material, label: str, stiffness_scale: float = 1.0):
     friction = contact.friction if contact else 0.5
     return wrapper.FrictMat(young=mat.young_modulus * stiffness_scale, poisson=mat.poisson_ratio,
                             density=mat.density, frictionAngle=math.atan(friction), label=label)
+
+
+#: what YADE's time step and the engine read of every YADE material: (attribute, range, unit)
+_PHYSICAL = (("young", YOUNG_MODULUS, "Pa"), ("poisson", POISSON_RATIO, "-"),
+             ("density", DENSITY, "kg/m3"))
+
+
+def check_physical(mat, what):
+    """Raise AttachError, one line, if YADE material `mat` (any with these attributes) has a
+    Young's modulus, Poisson's ratio or density outside its physical range (intervals.py);
+    `what` names it. Checked before a run: such values overflow the time step midway."""
+    for field, interval, unit in _PHYSICAL:
+        value = getattr(mat, field, None)
+        if value is not None and float(value) not in interval:
+            shown = "" if unit == "-" else f" {unit}"
+            raise AttachError(f"{what}: {field} = {value:g}{shown} is out of range: accepted "
+                              f"{interval}{shown}")
 
 
 def _as_material(name):
@@ -36,7 +54,10 @@ def add_materials(labels, stiffness_scale=1.0):
     mats, ids = {}, {}
     for label, name in labels.items():
         mats[label] = _as_material(name)
-        ids[label] = O.materials.append(_frict_material(mats[label], label, stiffness_scale))
+        frict = _frict_material(mats[label], label, stiffness_scale)
+        check_physical(frict, f"material '{label}' ({mats[label].source}) with stiffness_scale = "
+                              f"{stiffness_scale:g}")
+        ids[label] = O.materials.append(frict)
     en, es, fr = [], [], []
     for la in labels:
         for lb in labels:
@@ -103,6 +124,7 @@ def resolve(materials, kappa=None, emax_ratio=None):
         by_label[lab] = criterion_for(mat).overridden(kappa=kappa, emax_ratio=emax_ratio)
     stiffness, label_by_id = {}, {}
     for m in O.materials:
+        check_physical(m, f"YADE material {m.label or m.id!r}")
         young = getattr(m, "young", None)
         stiffness[m.id] = (math.inf if young is None
                            else float(model.hertz_stiffness(young, getattr(m, "poisson", 0.0))))

@@ -13,6 +13,10 @@ FAST_MAX_PERIOD = 200
 #: "fast" reads: the speed of every body is looked at every this many reads (a pass over all the
 #: bodies in Python, about 1 us each: 1/64 of it per read)
 SCAN_EVERY = 64
+#: "fast" reads: a contact that begins between reads may bring the weakest bodies this fraction
+#: of their material's fracture energies (at the smallest breakable size) no more than
+#: fast_tolerance of it before it is read
+ONSET_QUANTILE = 0.01
 
 
 class SmallestBreakable:
@@ -40,8 +44,9 @@ class ReadSchedule:
     time of the smallest breakable body) or "fast" (as often as the loading requires). The
     period is the PyRunner's iterPeriod."""
 
-    def __init__(self, options, engine_label, smallest):
+    def __init__(self, options, engine_label, smallest, low_energy=None):
         self.options = options                # config.Reading
+        self.low_energy = low_energy          # (id, u) -> fracture energy (J/kg) at quantile u
         self.mode = options.read_period if options.read_period in ("auto", "fast") else "every"
         self.period = (options.read_period if isinstance(options.read_period, int)
                        and self.mode == "every" else 1)           # "every_step": 1
@@ -52,6 +57,7 @@ class ReadSchedule:
         self._auto_key = None
         self._load_key = None
         self._load_time_1 = 0.0
+        self._onset_1 = 0.0
 
     def after_read(self, limits):
         """Set the period after a read; `limits` (a list or None) are the steps the loaded
@@ -83,6 +89,10 @@ class ReadSchedule:
           largest speed in the scene (the most energetic body's at every read, every body's every
           SCAN_EVERY reads, fresh fragments' when they appear), so that an impact that begins
           between reads is read several times while it loads;
+        - the time in which such an impact brings the smallest breakable sphere fast_tolerance of
+          the fracture energy of the weakest of its size (ONSET_QUANTILE; hertz_onset_time), so
+          that a contact that begins between reads is read before it can carry a body past its
+          fracture energy by more than the tolerance (at high energies: nearly every step);
         - FAST_MAX_PERIOD steps."""
         smallest = self.smallest()
         if smallest is None:
@@ -99,8 +109,14 @@ class ReadSchedule:
                 self._load_key = smallest
                 self._load_time_1 = float(placement.hertz_loading_time(
                     radius, mat.density, mat.young, mat.poisson, 1.0))   # at 1 m/s; ~ v^-1/5
-            load_time = self._load_time_1 * max(2.0 * speed, 1e-6) ** -0.2
-            k = min(FAST_MAX_PERIOD, int(self.options.fast_fraction * load_time / O.dt))
+                self._onset_1 = (math.inf if self.low_energy is None else float(
+                    placement.hertz_onset_time(radius, mat.density, mat.young, mat.poisson, 1.0,
+                                               self.options.fast_tolerance
+                                               * self.low_energy(bid, ONSET_QUANTILE))))  # ~ 1/v
+            closing = max(2.0 * speed, 1e-6)
+            wait = min(self.options.fast_fraction * self._load_time_1 * closing ** -0.2,
+                       self._onset_1 / closing)
+            k = min(FAST_MAX_PERIOD, int(wait / O.dt))
         if limits:
             k = min(k, int(min(limits)))
         self.set_period(max(1, k))

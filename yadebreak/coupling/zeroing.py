@@ -9,15 +9,18 @@ separates. The engine sleeps when there are no zeroed pairs.
 A pair inside its artificial overlap ("slack": no force) and opening needs no visit until its
 overlap may have shrunk by `tolerance` of itself: it sleeps that many steps, judged from its
 opening rate (at most MAX_SLEEP), and the work per step is bounded by the pairs awake. The only
-error is where a pair that turns round while asleep starts to push again: at most `tolerance` of
-its overlap later than with a visit every step (tolerance 0).
+error is where a pair that turns round while asleep closes again without force: it wakes with its
+zero raised to the overlap it then has, so that it pushes from there on and never with an overlap
+no force resisted (that would create energy); it pushes at most `tolerance` of its overlap later
+than with a visit every step (tolerance 0), and never harder.
 """
 from __future__ import annotations
 
-from ._yade import O, find_engine, utils, wrapper
+from ._yade import O, Vector3, find_engine, utils, wrapper
 
 #: a slack pair sleeps at most this many steps
 MAX_SLEEP = 50
+_NO_FORCE = Vector3(0.0, 0.0, 0.0)
 
 
 class ZeroedOverlap:
@@ -47,6 +50,7 @@ class OverlapZeroing:
         self.asleep = set()                      # slack pairs not visited until they wake
         self._wake_at = {}                       # step -> pairs that wake then
         self._cache = {}                         # pair -> YADE objects read every step
+        self._loaded_depth = {}                  # wall, facet pair -> overlap (m) when saved
 
     def __bool__(self):
         return bool(self.pairs)
@@ -98,12 +102,12 @@ class OverlapZeroing:
 
     def apply(self):
         """Before the InteractionLoop: scale kno, kso of every zeroed pair awake (sphere pairs
-        from this step's positions, walls and facets from the last step's overlap)."""
+        and spheres on walls from this step's positions, facets from the last step's overlap)."""
         if not self.pairs:
             find_engine(self.engine_label).dead = True
             return
         now = O.iter
-        self._wake(now)
+        woken = self._wake(now)
         cache, pairs, tolerance = self._cache, self.pairs, self.tolerance
         done, sleep = [], []
         for key in self.awake:
@@ -114,14 +118,22 @@ class OverlapZeroing:
                 if c is None:
                     done.append(key)
                     continue
-            state_a, state_b, radius_sum, phys, geom = c
+            state_a, state_b, radius_sum, phys, geom, through = c
             if geom is None:
                 d = radius_sum - (state_a.pos - state_b.pos).norm()
+            elif geom.__class__ is tuple:        # a sphere on a wall: (axis, sense)
+                axis, sense = geom
+                gap = state_a.pos[axis] - state_b.pos[axis]
+                d = radius_sum - (abs(gap) if sense == 0 else sense * gap)
             else:
                 d = geom.penetrationDepth
+                if d != d:                       # NaN: O.load does not keep it (see to_list)
+                    d = self._loaded_depth.get(key, z.seen_overlap)
             if d <= 0.0:
                 done.append(key)
                 continue
+            if woken and key in woken and d > z.artificial:
+                z.artificial = d                 # closed while asleep: pushes from here on
             if d <= z.artificial:
                 if tolerance and z.seen_iter >= 0 and d < z.seen_overlap:
                     # opening with no force: asleep until it may have closed `tolerance` of d
@@ -135,8 +147,16 @@ class OverlapZeroing:
             else:
                 ratio = (d - z.artificial) / d
                 phys.kno = z.kno0 * ratio ** 1.5
-                phys.kso = z.kso0 * ratio ** 0.5
+                if d < through:
+                    phys.kso = z.kso0 * ratio ** 0.5
+                else:
+                    # the contact point lies past the smaller sphere's centre (a fine fragment
+                    # inside a larger sibling): the law's shear lever would be negative and
+                    # pump spin into it, so the pair pushes without friction
+                    phys.kso = 0.0
+                    phys.shearForce = _NO_FORCE
             z.seen_overlap, z.seen_iter = d, now
+        self._loaded_depth.clear()
         for key in done:
             self._drop(key)
         for key, when in sleep:
@@ -145,12 +165,17 @@ class OverlapZeroing:
             self._wake_at.setdefault(when, []).append(key)
 
     def _wake(self, now):
-        """The pairs due now are awake again (pairs dropped while asleep are gone)."""
+        """The pairs due now are awake again (pairs dropped while asleep are gone); returns them
+        (None if none)."""
+        woken = None
         for when in [w for w in self._wake_at if w <= now]:
             for key in self._wake_at.pop(when):
                 if key in self.asleep:
                     self.asleep.discard(key)
                     self.awake.add(key)
+                    woken = woken or set()
+                    woken.add(key)
+        return woken
 
     def _objects(self, key):
         ba, bb = O.bodies[key[0]], O.bodies[key[1]]
@@ -160,14 +185,50 @@ class OverlapZeroing:
         if not inter.isReal:
             return None
         spheres = isinstance(ba.shape, wrapper.Sphere) and isinstance(bb.shape, wrapper.Sphere)
-        c = (ba.state, bb.state, (ba.shape.radius + bb.shape.radius) if spheres else 0.0,
-             inter.phys, None if spheres else inter.geom)
+        if spheres:
+            c = (ba.state, bb.state, ba.shape.radius + bb.shape.radius, inter.phys, None,
+                 2.0 * min(ba.shape.radius, bb.shape.radius))
+        elif isinstance(bb.shape, wrapper.Wall) or isinstance(ba.shape, wrapper.Wall):
+            # this step's overlap from the positions, as Ig2_Wall_Sphere_ScGeom will find it
+            # (the law's last overlap lags a step: a pair opening would push for one step more)
+            sphere, wall = (ba, bb) if isinstance(bb.shape, wrapper.Wall) else (bb, ba)
+            c = (sphere.state, wall.state, sphere.shape.radius, inter.phys,
+                 (wall.shape.axis, wall.shape.sense), 2.0 * sphere.shape.radius)
+        else:                                    # facets: the law's last overlap
+            sphere = ba if isinstance(ba.shape, wrapper.Sphere) else bb
+            c = (ba.state, bb.state, 0.0, inter.phys, inter.geom, 2.0 * sphere.shape.radius)
         self._cache[key] = c
         return c
 
     def to_list(self):
-        return [[a, b, *z.saved()] for (a, b), z in self.pairs.items()]
+        """Every pair with its last visit and, if asleep, the step it wakes at (-1: awake): a
+        restored scene goes on exactly as the saved one would have."""
+        wake_at = {key: when for when, keys in self._wake_at.items() for key in keys
+                   if key in self.asleep}
+        return [[a, b, *z.saved(), z.seen_overlap, z.seen_iter, wake_at.get((a, b), -1),
+                 self._depth((a, b))] for (a, b), z in self.pairs.items()]
+
+    def _depth(self, key):
+        """The overlap (m) of a wall or facet pair as YADE last computed it (None for spheres,
+        whose overlap comes from their positions): O.save does not keep ScGeom.penetrationDepth,
+        which apply() reads before the InteractionLoop has computed it again."""
+        if not O.interactions.has(*key):
+            return None
+        inter = O.interactions[key]
+        geom = inter.geom
+        if geom is None or all(isinstance(O.bodies[i].shape, wrapper.Sphere) for i in key):
+            return None
+        return geom.penetrationDepth
 
     def restore(self, rows):
         for a, b, *values in rows:
-            self._register((a, b), ZeroedOverlap(*values))
+            self._register((a, b), ZeroedOverlap(*values[:3]))
+            if len(values) > 3:                  # (saved before the visits were: all awake)
+                z = self.pairs[(a, b)]
+                z.seen_overlap, z.seen_iter, wake = values[3], int(values[4]), int(values[5])
+                if len(values) > 6 and values[6] is not None:
+                    self._loaded_depth[(a, b)] = values[6]
+                if wake >= 0:
+                    self.awake.discard((a, b))
+                    self.asleep.add((a, b))
+                    self._wake_at.setdefault(wake, []).append((a, b))
