@@ -1,5 +1,5 @@
 """Command line: `python -m yadebreak demo | families | materials | options | sweep | gather |
-tradeoff` (no YADE needed here; the workers of a sweep or a trade-off run YADE).
+tradeoff | fit | grind` (no YADE needed here; the workers of a sweep or a trade-off run YADE).
 
 Options are declared as the scripts' are (scriptargs: type, range, unit, default, help); a bad
 value stops with one line naming the option, the value, the range and the unit (exit code 2)."""
@@ -199,6 +199,17 @@ def _key_values(text_value, option):
     return out
 
 
+def _grind(args):
+    """`grind`: the mechanistic mill model (yadebreak.grinding); its input errors as one line."""
+    from .grinding import cli
+    try:
+        return cli.grind(args)
+    except (cli.SpectraError, cli.FeedError, cli.GrindingError) as exc:
+        if args.debug:
+            raise
+        fail(str(exc))
+
+
 #: each command: (function, help, its options[, its positional arguments (name, help)])
 COMMANDS = {
     "demo": (demo, "plot breakage probability and t10 curves of a material", [
@@ -224,6 +235,21 @@ COMMANDS = {
     "gather": (gather, "flatten every line's summary.json of a sweep into <out>/sweep.csv", [
         text("out", "out/sweep", "the folder holding <description>/summary.json per line")],
         [("table", "the yade-batch table")]),
+    "grind": (_grind, "minutes of batch grinding from a mill's collision "
+              "spectra (docs/grinding.md)", [
+        text("material", "copper_ore", "a material name or a .toml file"),
+        text("feed", "5.5", "a single feed size (mm) or a CSV file size_mm,passing_percent"),
+        number("minutes", 10.0, "min", "grinding time", lo=0, lo_open=True, hi=1e4),
+        number("interval", 0.5, "min", "time between outputs", lo=0, lo_open=True),
+        integer("classes", 16, "root-2 size classes below the feed's top size", lo=2, hi=60),
+        integer("cells", 120, "fracture-energy cells per class", lo=20, hi=2000),
+        integer("damage", 1, "1: survivors weakened by Eqs. 5-6; 0: no damage", lo=0, hi=1),
+        number("holdup", 0.0, "kg", "ore in the mill (0: the spectra's ore mass)", lo=0),
+        number("residence", 0.0, "min", "mean residence time of a continuous mill (0: batch)",
+               lo=0),
+        text("out", "out/grind", "output folder")],
+        [("spectra", "a spectra file, a mill run's --out folder (converted) or "
+          "synthetic:BALL_MM (docs/grinding.md)")]),
 }
 
 
@@ -231,10 +257,15 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["tradeoff"]:
         return tradeoff_command(argv[1:])
+    if argv[:1] == ["fit"]:                # DATA... takes several files: its own parser
+        from .calibration.cli import main as fit_main
+        return fit_main(argv[1:])
     parser = ScriptParser(prog="python -m yadebreak")
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("tradeoff", help="speed against accuracy of a script's options, over seeds "
                    "(python -m yadebreak tradeoff --help)")     # parsed by tradeoff_command
+    sub.add_parser("fit", help="a material file from laboratory data, with 95 %% intervals "
+                   "(python -m yadebreak fit --help; docs/calibration.md)")
     for name, (func, what, params, *positional) in COMMANDS.items():
         p = sub.add_parser(name, help=what, description=what)
         for arg, arg_help in (positional[0] if positional else ()):
