@@ -15,8 +15,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
-from yadebreak import coupling, poured_bed, scenes  # noqa: E402
-from yadebreak.coupling._yade import O  # noqa: E402
+from yadebreak import coupling, scenes  # noqa: E402
+from yadebreak.scenes import poured_bed  # noqa: E402
+from yadebreak.coupling.yade_api import O  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--layers", type=int, default=5)

@@ -21,7 +21,7 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 import numpy as np  # noqa: E402
 
 from yadebreak import coupling, scenes  # noqa: E402
-from yadebreak.coupling._yade import O, utils, wrapper as _wrapper  # noqa: E402
+from yadebreak.coupling.yade_api import O, utils, wrapper as _wrapper  # noqa: E402
 
 QUICK = "--quick" in sys.argv
 # O.run(n, True) waits in 40 ms polls, so steps are timed with coupling.run_steps (O.step in a
@@ -151,7 +151,7 @@ def end_to_end():
     every step: wall time and its shares."""
     import argparse
     import tempfile
-    from yadebreak import bed
+    from yadebreak.runs import bed
     print("\n3. The default bed impact end to end (target 3 minutes), where the time goes")
     for read, dummies in (("fast", "ledger"), (1, "spheres")):
         coupling.forget()

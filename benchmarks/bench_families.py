@@ -10,7 +10,8 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
 
-from yadebreak import families, load_material  # noqa: E402
+from yadebreak.model import families  # noqa: E402
+from yadebreak import load_material  # noqa: E402
 
 for name in ("copper_ore", "limestone", "granulite", "iron_ore_1"):
     mat = load_material(name)

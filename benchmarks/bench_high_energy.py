@@ -19,9 +19,10 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
 
-from yadebreak import coupling, load_material, reports, scenes  # noqa: E402
+from yadebreak import coupling, load_material, scenes  # noqa: E402
+from yadebreak.model import reports  # noqa: E402
 from yadebreak.coupling import run_steps  # noqa: E402
-from yadebreak.coupling._yade import O  # noqa: E402
+from yadebreak.coupling.yade_api import O  # noqa: E402
 
 SIZE = 10e-3
 

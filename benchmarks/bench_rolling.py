@@ -17,7 +17,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 from yadebreak import coupling, scenes  # noqa: E402
-from yadebreak.coupling._yade import O  # noqa: E402
+from yadebreak.coupling.yade_api import O  # noqa: E402
 
 QUICK = "--quick" in sys.argv
 STEPS = 3000 if QUICK else 10000

@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 import numpy as np  # noqa: E402
 
 from yadebreak import coupling, scenes  # noqa: E402
-from yadebreak.coupling._yade import O, utils  # noqa: E402
+from yadebreak.coupling.yade_api import O, utils  # noqa: E402
 from yadebreak.coupling.config import Config  # noqa: E402
 from yadebreak.coupling.stepping import smallest_rayleigh_time  # noqa: E402
 
@@ -200,7 +200,7 @@ def _mill_args(out):
 def mill(steps=3000, repeats=1):
     """The default mill once settled, run from the same saved state in each mode."""
     import tempfile
-    from yadebreak import mill as mill_scene
+    from yadebreak.runs import mill as mill_scene
     print(f"\n4. The default ball mill (scripts/ball_mill.py), from the charge settled (median of "
           f"{repeats})")
     with tempfile.TemporaryDirectory() as out:

@@ -18,7 +18,8 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
 
-from yadebreak import coupling, load_material, reports, scenes  # noqa: E402
+from yadebreak import coupling, load_material, scenes  # noqa: E402
+from yadebreak.model import reports  # noqa: E402
 
 
 def run(material, size, energy, particles, per_scene):

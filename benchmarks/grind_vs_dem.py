@@ -24,10 +24,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
-from yadebreak import milling  # noqa: E402
-from yadebreak.grinding import (BatchGrinder, feed_masses, from_mill_run,  # noqa: E402
+from yadebreak.model import milling  # noqa: E402
+from yadebreak.tools.grinding import (BatchGrinder, feed_masses, from_mill_run,  # noqa: E402
                                 root2_classes)
-from yadebreak.materials import load_material  # noqa: E402
+from yadebreak.model.materials import load_material  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("spectra_run")

@@ -20,7 +20,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.scriptargs import (checkpointed_run_options, integer, number,  # noqa: E402
+from yadebreak.tools.options import (checkpointed_run_options, integer, number,  # noqa: E402
                                   script_params, text)
 
 args = script_params([
@@ -43,7 +43,7 @@ args = script_params([
     *checkpointed_run_options(5e-5, "out/agglomerate_impact"),
 ], __doc__)
 
-from yadebreak import agglomerate  # noqa: E402
-from yadebreak.scriptargs import run_script  # noqa: E402
+from yadebreak.runs import agglomerate  # noqa: E402
+from yadebreak.tools.options import run_script  # noqa: E402
 
 summary = run_script(agglomerate.run, args)

@@ -20,7 +20,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.scriptargs import (checkpointed_run_options, integer,  # noqa: E402
+from yadebreak.tools.options import (checkpointed_run_options, integer,  # noqa: E402
                                   material_option, number, read_period_option,
                                   script_params, size_option, time_step_option)
 
@@ -54,7 +54,7 @@ args = script_params([
     *checkpointed_run_options(0.05, "out/ball_mill"),
 ], __doc__)
 
-from yadebreak import mill  # noqa: E402
-from yadebreak.scriptargs import run_script  # noqa: E402
+from yadebreak.runs import mill  # noqa: E402
+from yadebreak.tools.options import run_script  # noqa: E402
 
 brk, summary = run_script(mill.run, args) or (None, None)   # None: resumed a finished run

@@ -17,7 +17,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.scriptargs import (checkpointed_run_options, choice, fail,  # noqa: E402
+from yadebreak.tools.options import (checkpointed_run_options, choice, fail,  # noqa: E402
                                   flag, integer, material_option, number, read_period_option,
                                   script_params, size_option, text, time_step_option)
 
@@ -58,7 +58,7 @@ if args.packing == "poured" and args.layers < 2:
     fail(f"--packing = poured: must be with --layers >= 2 (got {args.layers}); a monolayer is "
          "laid as a lattice")
 
-from yadebreak import bed  # noqa: E402
-from yadebreak.scriptargs import run_script  # noqa: E402
+from yadebreak.runs import bed  # noqa: E402
+from yadebreak.tools.options import run_script  # noqa: E402
 
 brk, result = run_script(bed.run, args) or (None, None)   # None: resumed a finished run

@@ -17,7 +17,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.scriptargs import progress  # noqa: E402
+from yadebreak.tools.options import progress  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 parser.add_argument("--out", default="out/extremes", help="output folder; default out/extremes")
@@ -27,7 +27,7 @@ parser.add_argument("--only", default="",
                     help="run the cases whose name contains this text; default all cases")
 args, _ = parser.parse_known_args()
 
-from yadebreak import extremes  # noqa: E402
+from yadebreak.runs import extremes  # noqa: E402
 
 out = Path(args.out)
 out.mkdir(parents=True, exist_ok=True)

@@ -25,8 +25,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from yadebreak import sweep as sweep_tables  # noqa: E402
-from yadebreak.reports import bounded_errors  # noqa: E402
+from yadebreak.tools import sweep as sweep_tables  # noqa: E402
+from yadebreak.model.reports import bounded_errors  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--sweep", default="out/sweep",

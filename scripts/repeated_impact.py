@@ -20,8 +20,9 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 
 import numpy as np  # noqa: E402
 
-from yadebreak import load_material, model, reports  # noqa: E402
-from yadebreak.scriptargs import (ScriptError, check_not_finished,  # noqa: E402
+from yadebreak import load_material, model  # noqa: E402
+from yadebreak.model import reports  # noqa: E402
+from yadebreak.tools.options import (ScriptError, check_not_finished,  # noqa: E402
                                   check_resume_arguments, flag, integer, mark_finished,
                                   mark_started, material_option, number,
                                   partial_outputs_on_failure, progress, read_checkpoint,

@@ -22,8 +22,9 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets
 
 import numpy as np  # noqa: E402
 
-from yadebreak import load_material, reports  # noqa: E402
-from yadebreak.scriptargs import (PartialResults, flag, integer, material_option,  # noqa: E402
+from yadebreak import load_material  # noqa: E402
+from yadebreak.model import reports  # noqa: E402
+from yadebreak.tools.options import (PartialResults, flag, integer, material_option,  # noqa: E402
                                   numbers, partial_outputs_on_failure, progress, read_period_option,
                                   read_period_value, run_script,
                                   script_params, size_option, text, time_left, time_step_option)

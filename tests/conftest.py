@@ -1,6 +1,6 @@
 import pytest
 
-from yadebreak.yadepath import ensure_yade_importable
+from yadebreak.coupling.yadepath import ensure_yade_importable
 
 HAVE_YADE = ensure_yade_importable()
 

@@ -7,7 +7,7 @@ import pytest
 
 import yadebreak
 from yadebreak import load_material, model
-from yadebreak.materials import MaterialError
+from yadebreak.model.materials import MaterialError
 
 AB = load_material("ab_t10_ore")
 STEEL = load_material("steel")
@@ -130,7 +130,7 @@ def test_example_material_loads_and_dispatches():
         AB.t10(1.0)
 
 
-AB_GOOD = (yadebreak.materials.MATERIALS_DIR / "ab_t10_ore.toml").read_text()
+AB_GOOD = (yadebreak.model.materials.MATERIALS_DIR / "ab_t10_ore.toml").read_text()
 
 
 @pytest.mark.parametrize("old, new, message", [
@@ -197,15 +197,15 @@ def test_repeated_impacts_accumulate_and_follow_the_closed_form(scene):
 @pytest.mark.yade
 def test_one_scene_runs_both_criteria_and_fragments_pause(scene):
     """Tavares and Ab-T10 particles side by side; fragments count no energy for pause_steps."""
-    from yade import O
+    from yade import O, utils
     from yadebreak import scenes
     from yadebreak.coupling import add_materials, attach
     ip2, _ = add_materials({"cu": "copper_ore", "ab": "ab_t10_ore", "plate": "steel"})
-    O.bodies.append(scenes.utils.wall(0.0, axis=2, sense=1, material="plate"))
+    O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="plate"))
     r = SIZE / 2
     ids = {}
     for k, lab in enumerate(["cu", "ab"] * 10):
-        b = scenes.utils.sphere((4 * SIZE * k, 0, r * 1.02), r, material=lab)
+        b = utils.sphere((4 * SIZE * k, 0, r * 1.02), r, material=lab)
         b.state.vel = (0, 0, -40.0)                   # 800 J/kg: about half the copper ore
                                                       # and 95 % of the Ab-T10 ore break
         ids[O.bodies.append(b)] = lab

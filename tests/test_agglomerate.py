@@ -16,7 +16,7 @@ pytestmark = pytest.mark.yade
 def _two_spheres(radius, distance, binder_changes, seed=1):
     """Two glass spheres `distance` apart along x bonded by one beam; sphere 0 fixed."""
     from yade import O, utils
-    from yadebreak import bonds
+    from yadebreak.model import bonds
     from yadebreak.coupling import bonded
     mat = bonds.load_agglomerate_material("glass_epoxy")
     mat = mat.with_binder(**binder_changes)
@@ -39,7 +39,7 @@ def test_single_bond_tension_gives_E_B_and_breaks_at_its_strength(scene):
     The stress-strain slope is E_B; the bond breaks in tension within one step of reaching its
     own (drawn) tensile strength."""
     from yade import O
-    from yadebreak import bonds
+    from yadebreak.model import bonds
     length, radius = 12.5e-3, 1e-3
     mat, ids, watch = _two_spheres(radius, length, {"radius_multiplier": 0.67})
     area = math.pi * (0.67e-3) ** 2
@@ -68,7 +68,7 @@ def test_bonded_cantilever_deflects_as_timoshenko(scene):
     deflection is P L^3 / (3 E I) (1 + Phi / 4), its rotation P L^2 / (2 E I), and the larger end
     moment (at the clamp) P L."""
     from yade import O
-    from yadebreak import bonds
+    from yadebreak.model import bonds
     from yadebreak.coupling import bonded
     length, radius = 2e-3, 0.8e-3
     mat, ids, watch = _two_spheres(radius, length, {"radius_multiplier": 0.5,
@@ -110,7 +110,8 @@ def test_small_agglomerate_breaks_as_the_document_reports(scene, tmp_path):
     broken bonds and the summary agree; broken bonds' spheres that touch again do so by
     Hertz-Mindlin, never by a bond."""
     from yade import O
-    from yadebreak import agglomerate, bonds
+    from yadebreak.runs import agglomerate
+    from yadebreak.model import bonds
     summary = agglomerate.run(_args(tmp_path), quiet=True)
     assert summary["end_reason"] == "finished"
     assert summary["particles"] == 250
@@ -156,7 +157,7 @@ def agglomerate_watch():
 
 
 def test_build_and_breakage_are_reproducible_from_the_seed(scene, tmp_path):
-    from yadebreak import agglomerate
+    from yadebreak.runs import agglomerate
     first = agglomerate.run(_args(tmp_path / "a", particles=120, duration=1e-4), quiet=True)
     second = agglomerate.run(_args(tmp_path / "b", particles=120, duration=1e-4), quiet=True)
     assert (tmp_path / "a" / "bonds_broken.csv").read_text() == (
@@ -172,7 +173,8 @@ def test_the_scalar_screen_never_misses_a_bond_near_its_strength(scene, tmp_path
     """BondWatch computes exact end moments only where a scalar upper bound reaches 80 % of a
     strength: mid-impact, the exact stresses of every intact bond give the same counts and the
     same failing bonds."""
-    from yadebreak import agglomerate, bonds
+    from yadebreak.runs import agglomerate
+    from yadebreak.model import bonds
     from yadebreak.coupling import bonded
     from yade import O
     agglomerate.run(_args(tmp_path, particles=200, duration=2e-5), quiet=True)
@@ -212,9 +214,9 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
     times) are the uninterrupted run's to the last digit: checkpoints are written where every run
     renews its contacts as a load would (bonded.renew_contacts)."""
     from yade import O
-    from yadebreak import agglomerate
+    from yadebreak.runs import agglomerate
     from yadebreak.coupling import bonded
-    from yadebreak.scriptargs import RunFinished, ScriptError
+    from yadebreak.tools.options import RunFinished, ScriptError
     small = dict(particles=120, duration=1.5e-4)     # 89 of 431 bonds break, by 0.1 ms
     whole = agglomerate.run(_args(tmp_path / "whole", checkpoint_every=-1.0, **small), quiet=True)
     cut = tmp_path / "cut"
@@ -252,8 +254,8 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
 
 
 def test_a_damaged_checkpoint_is_refused_in_one_line(scene, tmp_path):
-    from yadebreak import agglomerate
-    from yadebreak.scriptargs import ScriptError
+    from yadebreak.runs import agglomerate
+    from yadebreak.tools.options import ScriptError
     (tmp_path / "checkpoint.yade.gz").write_bytes(b"\x1f\x8b\x08garbage")
     with pytest.raises(ScriptError, match=r"checkpoint.yade.gz is damaged .*run again without "
                                           r"--resume$"):
@@ -266,7 +268,7 @@ def test_a_time_step_that_cannot_finish_is_refused_before_the_run(scene, tmp_pat
     counter; 1e-300 a time step whose square (in the rolling stiffness) is no float: both refused
     in one line before a step is taken."""
     from yade import O
-    from yadebreak import agglomerate
+    from yadebreak.runs import agglomerate
     from yadebreak.coupling import AttachError
     for fraction, steps in ((1e-18, r"needs \d\.\d+e\+2\d steps "),
                             (1e-300, r"needs \d\.\d+e\+30\d steps ")):
@@ -286,7 +288,7 @@ def test_a_bonded_scene_loads_with_its_watch_and_a_plain_save_is_refused(scene, 
     counts, and the run goes on breaking bonds); a scene O.saved later, whose stored state is
     stale, is refused at its first step rather than run with the wrong bonds."""
     from yade import O
-    from yadebreak import agglomerate
+    from yadebreak.runs import agglomerate
     from yadebreak.coupling import bonded
     material, packing = agglomerate.build(_args(tmp_path, particles=60))
     O.reset()

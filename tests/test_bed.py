@@ -19,7 +19,7 @@ def _args(out, energy, seed=3, rings=1):
 
 
 def test_small_bed_writes_every_output_and_conserves_mass(scene, tmp_path):
-    from yadebreak import bed
+    from yadebreak.runs import bed
     brk, summary = bed.run(_args(tmp_path, 0.6), quiet=True)
     for name in ("summary.json", "events.jsonl", "size_distribution.csv", "size_distribution.png",
                  "bed_top_view.png", "paraview/spheres.pvd", "paraview/surfaces.pvd"):
@@ -36,7 +36,8 @@ def test_small_bed_writes_every_output_and_conserves_mass(scene, tmp_path):
 
 
 def test_higher_energy_breaks_more_mass(scene, tmp_path):
-    from yadebreak import bed, coupling
+    from yadebreak.runs import bed
+    from yadebreak import coupling
     from yade import O
     masses = []
     for energy in (0.3, 0.9):
@@ -61,7 +62,8 @@ def test_bed_script_runs_headless(tmp_path):
 
 def test_resume_continues_exactly_like_an_uninterrupted_run(scene, tmp_path):
     """A run that dies after a checkpoint and goes on with --resume gives the same results."""
-    from yadebreak import bed, coupling
+    from yadebreak.runs import bed
+    from yadebreak import coupling
     from yade import O
     whole = _args(tmp_path / "whole", 0.9, seed=5)
     whole.checkpoint_every = -1                    # never

@@ -1,12 +1,12 @@
-"""The bonded-agglomerate model (yadebreak.bonds): no YADE needed."""
+"""The bonded-agglomerate model (yadebreak.model.bonds): no YADE needed."""
 import math
 
 import numpy as np
 import pytest
 from scipy import stats
 
-from yadebreak import bonds
-from yadebreak.materials import (MATERIALS_DIR, MaterialError, available_materials,
+from yadebreak.model import bonds
+from yadebreak.model.materials import (MATERIALS_DIR, MaterialError, available_materials,
                                  load_material)
 
 E, NU = 3e9, 0.4

@@ -21,9 +21,9 @@ import numpy as np
 import pytest
 
 from yadebreak import model
-from yadebreak.calibration import (ab_t10, bootstrap, damage, data, examples, fit_all, fracture,
+from yadebreak.tools.calibration import (ab_t10, bootstrap, damage, data, examples, fit_all, fracture,
                                    progeny, t10)
-from yadebreak.materials import load_material
+from yadebreak.model.materials import load_material
 
 REPO = Path(__file__).resolve().parent.parent
 TAVARES = ("copper_ore", "granulite", "limestone_2", "iron_ore_1")

@@ -56,7 +56,8 @@ def test_stepping_from_a_function_leaves_the_users_globals_alone(tmp_path):
 
 def test_a_smaller_time_step_set_before_attach_is_kept_a_larger_one_lowered(scene):
     from yade import O
-    from yadebreak import placement, load_material
+    from yadebreak.model import placement
+    from yadebreak import load_material
     cu = load_material("copper_ore")
     tr = float(placement.rayleigh_time(0.00275, cu.density, cu.young_modulus, cu.poisson_ratio))
     coupling = _scene()

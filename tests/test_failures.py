@@ -12,8 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from yadebreak import reports, scriptargs
-from yadebreak.scriptargs import partial_outputs_on_failure, time_left
+from yadebreak.model import reports
+from yadebreak.tools import options as scriptargs
+from yadebreak.tools.options import partial_outputs_on_failure, time_left
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -111,7 +112,8 @@ def _bed_args(out, **changes):
 @pytest.mark.yade
 def test_a_bed_run_that_fails_midway_leaves_its_outputs_and_says_why(scene, tmp_path,
                                                                       monkeypatch):
-    from yadebreak import bed, coupling
+    from yadebreak.runs import bed
+    from yadebreak import coupling
     real, calls = coupling.run_steps, []
 
     def failing(n):                     # the fourth batch of steps fails, mid-impact
@@ -134,7 +136,7 @@ def test_a_bed_run_that_fails_midway_leaves_its_outputs_and_says_why(scene, tmp_
 
 @pytest.mark.yade
 def test_a_bed_run_stopped_by_max_time_says_so(scene, tmp_path):
-    from yadebreak import bed
+    from yadebreak.runs import bed
     _, summary = bed.run(_bed_args(tmp_path, max_time=2e-4), quiet=True)
     assert summary["end_reason"] == "time_limit"
     assert "--max-time 0.0002 s" in summary["end_message"]
@@ -175,7 +177,7 @@ def test_a_small_bed_says_why_it_took_longer(scene, tmp_path, capsys):
     """One ring under 1.5 J (7 particles) breaks finer than the default bed: the run reports the
     energy per kg of bed at the start, and at the end the fall of the time step and the finest
     fragment that caused it, from its own summary."""
-    from yadebreak import bed
+    from yadebreak.runs import bed
     _, summary = bed.run(_bed_args(tmp_path, energy=1.5), quiet=False)
     said = capsys.readouterr().out
     per_kg = summary["energy"] / summary["initial_mass"]
@@ -210,7 +212,7 @@ def test_a_second_run_into_an_out_in_use_is_refused_and_a_killed_one_leaves_no_l
                                                                                     capsys):
     holder = subprocess.Popen(
         ["nice", "-n", "5", sys.executable, "-c", "import sys, time; sys.path.insert(0, "
-         "sys.argv[1]); from yadebreak.scriptargs import lock_out; lock_out(sys.argv[2]); "
+         "sys.argv[1]); from yadebreak.tools.options import lock_out; lock_out(sys.argv[2]); "
          "print('locked', flush=True); time.sleep(120)", str(ROOT), str(tmp_path)],
         stdout=subprocess.PIPE, text=True)
     try:
@@ -328,7 +330,7 @@ def _partial_results(tmp_path, **changes):
     args.resume = True
 
     def validate(key, result):
-        from yadebreak import reports
+        from yadebreak.model import reports
         reports.check_breakage_result(result, mat, 5.5e-3, float(key), steel, args.particles)
     return args, validate
 
@@ -377,7 +379,8 @@ def test_a_sound_partial_file_resumes(tmp_path):
 @pytest.mark.parametrize("damage", ["truncated", "empty", "garbage"])
 def test_a_damaged_checkpoint_is_refused_in_one_line_claiming_nothing(scene, tmp_path, capsys,
                                                                       damage):
-    from yadebreak import bed, coupling, mill
+    from yadebreak.runs import bed, mill
+    from yadebreak import coupling
     assert bed.run(_bed_args(tmp_path, checkpoint_every=0.0, stop_after=1e-4), quiet=True)[1] \
         is None
     path = tmp_path / "checkpoint.yade.gz"
@@ -426,7 +429,8 @@ def test_a_full_disk_stops_the_run_in_one_line_keeping_the_last_checkpoint(scene
     """Checkpoints at every chunk of steps; the third one finds the disk full: the run stops with
     one line naming what it wrote, summary.json says why, and the second checkpoint, whole, goes
     on with --resume 1 to the end of the run."""
-    from yadebreak import bed, coupling
+    from yadebreak.runs import bed
+    from yadebreak import coupling
     from yadebreak.coupling import engine
     full, calls = _full_disk(after=2)
     monkeypatch.setattr(engine, "save", full(engine.save))
@@ -453,7 +457,7 @@ def test_a_full_disk_stops_the_run_in_one_line_keeping_the_last_checkpoint(scene
 def test_a_disk_full_of_frames_and_summaries_says_nothing_was_summarised(scene, tmp_path, capsys,
                                                                         monkeypatch):
     """No frame and no summary can be written: the line says so and names only what exists."""
-    from yadebreak import bed, paraview
+    from yadebreak.runs import bed, paraview
     full, calls = _full_disk(after=1)                   # the first frame, then nothing
     monkeypatch.setattr(paraview, "write_atomic", full(paraview.write_atomic))
     monkeypatch.setattr(bed, "write_atomic", full(bed.write_atomic))

@@ -2,8 +2,9 @@
 import numpy as np
 import pytest
 
-from yadebreak import families, model
-from yadebreak.materials import available_materials, load_material
+from yadebreak.model import families
+from yadebreak import model
+from yadebreak.model.materials import available_materials, load_material
 
 BREAKABLE = [n for n in available_materials() if load_material(n).breakable]
 

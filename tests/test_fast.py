@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from yadebreak import load_material, model, placement
+from yadebreak import load_material, model
+from yadebreak.model import placement
 
 
 def test_parabolic_peak_recovers_a_parabola_and_refuses_the_rest():
@@ -31,7 +32,7 @@ def test_hertz_loading_time_matches_a_measured_impact(scene):
     """The overlap of a 20 m/s impact on steel peaks at the predicted loading time (steel's
     compliance lengthens it a little: within 15 %)."""
     from yade import O
-    from yadebreak import scenes
+    from yadebreak import coupling, scenes
     cu = load_material("copper_ore")
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [20.0], gap_fraction=0.0)
     brk.bodies[ids[0]].fracture_energy = 1e12
@@ -50,7 +51,7 @@ def test_hertz_loading_time_matches_a_measured_impact(scene):
 
 @pytest.mark.yade
 def test_fast_wall_impacts_receive_e_m_v2_over_2_within_3_percent(scene):
-    from yadebreak import scenes
+    from yadebreak import coupling, scenes
     speeds = [1.0, 5.0, 20.0, 100.0]
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=speeds, emin=0.0,
                                    read_period="fast")
@@ -58,7 +59,7 @@ def test_fast_wall_impacts_receive_e_m_v2_over_2_within_3_percent(scene):
         brk.bodies[i].fracture_energy = 1e12
     periods = set()
     for _ in range(400):
-        scenes.run_steps(5)
+        coupling.run_steps(5)
         periods.add(brk.period)
     e = load_material("copper_ore").energy_partition(load_material("steel"))
     got = {ev["id"]: ev["specific_energy"] for ev in brk.events if ev["kind"] == "damage"}
@@ -70,14 +71,14 @@ def test_fast_wall_impacts_receive_e_m_v2_over_2_within_3_percent(scene):
 def test_fast_reads_less_often_where_a_fresh_contact_cannot_bring_much_energy(scene):
     """At 1 m/s a fresh contact brings the weakest 5.5 mm copper ore particles 2 % of their
     fracture energy only after several steps (hertz_onset_time): "fast" waits that long."""
-    from yadebreak import scenes
-    from yadebreak.coupling._yade import O
+    from yadebreak import coupling, scenes
+    from yadebreak.coupling.yade_api import O
     from yadebreak.coupling.stepping import ONSET_QUANTILE
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=[1.0], read_period="fast")
     cu = load_material("copper_ore")
     onset = placement.hertz_onset_time(2.75e-3, cu.density, cu.young_modulus, cu.poisson_ratio,
                                        2.0, 0.02 * cu.fracture_energy_ppf(ONSET_QUANTILE, 5.5e-3))
-    scenes.run_steps(20)
+    coupling.run_steps(20)
     assert brk.period == min(int(0.25 * placement.hertz_loading_time(
         2.75e-3, cu.density, cu.young_modulus, cu.poisson_ratio, 2.0) / O.dt),
         int(onset / O.dt))

@@ -1,4 +1,4 @@
-"""The mechanistic mill model (yadebreak.grinding): population balance against closed forms,
+"""The mechanistic mill model (yadebreak.tools.grinding): population balance against closed forms,
 the capture model, the spectra file and its converter, and the known behaviours of batch ball
 milling on small cases (docs/grinding.md). No YADE needed; every case runs in about a second."""
 import csv
@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from yadebreak.grinding import (BatchGrinder, GrindingError, SpectraError, feed_masses,
+from yadebreak.tools.grinding import (BatchGrinder, GrindingError, SpectraError, feed_masses,
                                 from_mill_run, read_spectra, reid_batch, root2_classes,
                                 synthetic_spectra, write_spectra)
-from yadebreak.grinding.capture import PACKING_MONOLAYER
-from yadebreak.grinding.classes import FeedError
-from yadebreak.materials import load_material
+from yadebreak.tools.grinding.capture import PACKING_MONOLAYER
+from yadebreak.tools.grinding.classes import FeedError
+from yadebreak.model.materials import load_material
 
 COPPER = load_material("copper_ore")
 #: copper ore so weak (E50 ~ 1e-9 J/kg) that every stressed particle breaks: the model reduces

@@ -40,7 +40,8 @@ def test_fragments_go_on_breaking_after_the_originals_broke(scene):
     follows the fragments, later generations break, and the progeny is finer than the same
     impact stopped once the originals had broken (what the runs did before): the same seed, so
     the same primary events."""
-    from yadebreak import coupling, reports, scenes
+    from yadebreak import coupling, scenes
+    from yadebreak.model import reports
     cu, steel = load_material("copper_ore"), load_material("steel")
     t10 = {}
     for follow in (False, True):
@@ -60,7 +61,8 @@ def test_fragments_go_on_breaking_after_the_originals_broke(scene):
 
 @pytest.mark.yade
 def test_an_energy_where_nothing_breaks_says_why_it_has_no_t10(scene):
-    from yadebreak import reports, scenes
+    from yadebreak.model import reports
+    from yadebreak import scenes
     cu, steel = load_material("copper_ore"), load_material("steel")
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [np.sqrt(2 * 5.0)] * 3, seed=1)
     scenes.run_until_rebound(ids, brk=brk)
@@ -132,7 +134,8 @@ def test_one_scene_is_the_run_it_always_was(scene, tmp_path):
     """single_impacts with every particle in one scene gives what impact_scene, run_until_rebound
     and breakage_result gave (the same seed: the same run), event for event."""
     from yade import O
-    from yadebreak import coupling, reports, scenes
+    from yadebreak import coupling, scenes
+    from yadebreak.model import reports
     cu, steel, speed = load_material("copper_ore"), load_material("steel"), np.sqrt(2 * 700.0)
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [speed] * 6, seed=4)
     scenes.run_until_rebound(ids, brk=brk)
@@ -173,7 +176,8 @@ def test_breakage_probability_does_not_depend_on_the_scene_size(scene):
     scene and in scenes of one, the broken fractions are two samples of the same binomial; they
     differ by less than 3 sigma of a difference, sqrt(2 P (1 - P) / 60) = 0.09 at P = 0.5, and
     each lies within 3 sigma of the model."""
-    from yadebreak import reports, scenes
+    from yadebreak.model import reports
+    from yadebreak import scenes
     cu, steel, speed, n = load_material("copper_ore"), load_material("steel"), np.sqrt(1000.0), 60
     p_model = float(cu.breakage_probability(500.0, 5.5e-3, partner=steel))
     sigma = np.sqrt(p_model * (1 - p_model) / n)
@@ -192,7 +196,8 @@ def test_scenes_shared_among_processes_give_the_same_run(scene, tmp_path):
     """Five scenes of one copper ore particle at 700 J/kg, run here and shared between two YADE
     processes: the same events in the same order (each scene has its seed), and the same result
     but for the order of the sums over scenes (1e-9 relative)."""
-    from yadebreak import reports, scenes
+    from yadebreak.model import reports
+    from yadebreak import scenes
     cu, steel, speed = load_material("copper_ore"), load_material("steel"), np.sqrt(2 * 700.0)
     results, logs = [], []
     for jobs in (1, 2):

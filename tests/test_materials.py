@@ -8,9 +8,9 @@ import pytest
 
 import yadebreak
 from yadebreak import model
-from yadebreak.materials import MaterialError, available_materials, load_material
+from yadebreak.model.materials import MaterialError, available_materials, load_material
 
-GOOD = (yadebreak.materials.MATERIALS_DIR / "copper_ore.toml").read_text()
+GOOD = (yadebreak.model.materials.MATERIALS_DIR / "copper_ore.toml").read_text()
 
 
 def test_every_shipped_material_loads():
@@ -128,7 +128,7 @@ def test_within_the_ranges_the_rayleigh_time_step_is_finite_and_positive():
     """What intervals.py's ranges promise: at their corners, the Rayleigh time of a sphere of
     radius R (m) lies within 4.1e-5 R and 2.9 R s, so no material file can overflow the time step
     (the smallest radius of the size range gives a step well above float's smallest)."""
-    from yadebreak import intervals, placement
+    from yadebreak.model import intervals, placement
     corners = [placement.rayleigh_time(1.0, rho, young, nu)
                for rho in (intervals.DENSITY.lo, intervals.DENSITY.hi)
                for young in (intervals.YOUNG_MODULUS.lo, intervals.YOUNG_MODULUS.hi)

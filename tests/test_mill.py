@@ -24,7 +24,8 @@ def _args(out, **changes):
 
 def test_a_short_mill_run_keeps_mass_stays_finite_and_the_motor_does_work(scene, tmp_path):
     from yade import O
-    from yadebreak import mill, milling
+    from yadebreak.runs import mill
+    from yadebreak.model import milling
     brk, summary = mill.run(_args(tmp_path), quiet=True)
     assert summary["end_reason"] == "finished"
     assert summary["balls"] > 10 and summary["ore_particles"] > 50
@@ -58,7 +59,7 @@ def test_a_short_mill_run_keeps_mass_stays_finite_and_the_motor_does_work(scene,
 
 def test_the_charge_fills_the_drum_as_asked(scene, tmp_path):
     """Fillings are bulk volumes over the drum's volume, the bulk PACKING solid."""
-    from yadebreak import mill
+    from yadebreak.runs import mill
     args = _args(tmp_path)
     balls, ores = mill.charge_counts(args)
     volume = math.pi * 0.06 ** 2 * 0.04
@@ -74,8 +75,9 @@ def test_a_resumed_mill_goes_on_from_its_checkpoint_and_refuses_other_arguments(
     the last digit (measured: the first event after the cut differs at 1e-16), and a granular flow
     amplifies that. Resumed with another speed: refused, naming it."""
     from yade import O
-    from yadebreak import coupling, mill
-    from yadebreak.scriptargs import ScriptError
+    from yadebreak import coupling
+    from yadebreak.runs import mill
+    from yadebreak.tools.options import ScriptError
     _, whole = mill.run(_args(tmp_path / "whole", duration=0.04, checkpoint_every=0.0),
                         quiet=True)
     whole_events = [json.loads(x) for x in

@@ -1,11 +1,11 @@
-"""The ball-mill model layer (yadebreak.milling): no YADE needed. Every expected number is written
+"""The ball-mill model layer (yadebreak.model.milling): no YADE needed. Every expected number is written
 out here from its closed form, not obtained by calling the function under test again."""
 import math
 
 import numpy as np
 import pytest
 
-from yadebreak import milling
+from yadebreak.model import milling
 
 
 # --------------------------------------------------------------------------- critical speed

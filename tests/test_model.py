@@ -122,7 +122,7 @@ def test_eq10_table1_at_t10_3_percent():
 def test_eq10_against_the_paper_table2_family_mixture():
     # The probability-weighted families of Table 2, read at the class boundaries as docs/model.md does
     # (59.5, 40.0, 17.9, 5.72 %), agree with Eq. 10 to within 4 %: the confirmation of Eq. 10.
-    from yadebreak import families
+    from yadebreak.model import families
     counts = np.array([[0, 1, 0, 1, 0, 1, 1, 0, 1, 1, 5], [0, 1, 0, 0, 2, 0, 1, 1, 2, 1, 5],
                        [0, 0, 2, 0, 1, 1, 0, 1, 0, 2, 5], [0, 0, 1, 2, 0, 1, 1, 2, 0, 0, 6],
                        [0, 1, 0, 1, 0, 1, 1, 1, 0, 1, 4], [0, 1, 0, 1, 0, 1, 0, 2, 1, 1, 5],
@@ -178,7 +178,7 @@ def test_size_distribution_conserves_mass():
 def test_pouring_column_is_loose_and_inside_its_holder():
     """placement.pouring_column: the requested count, every sphere clear of the others, of the
     holder's wall and of the anvil, in levels from the bottom up; refuses a holder too narrow."""
-    from yadebreak import placement
+    from yadebreak.model import placement
     r, holder = 2.75e-3, 19.5e-3
     pos = placement.pouring_column(169, r, holder, np.random.default_rng(4))
     assert pos.shape == (169, 3)

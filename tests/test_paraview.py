@@ -51,7 +51,8 @@ def read_vtp(path):
 def bed_run(tmp_path_factory):
     """One tiny bed impact with a frame every INTERVAL (the YADE scene reset before and after)."""
     from yade import O
-    from yadebreak import bed, coupling
+    from yadebreak.runs import bed
+    from yadebreak import coupling
     out = tmp_path_factory.mktemp("bed")
     coupling.forget()
     O.reset()
@@ -133,7 +134,7 @@ def test_anvil_is_a_square_under_the_bed(bed_run):
 
 
 def test_interval_zero_writes_no_series_and_a_bad_one_is_refused(scene, tmp_path):
-    from yadebreak import paraview
+    from yadebreak.runs import paraview
     frames = paraview.series(tmp_path / "none", None, 0.0)
     frames()
     frames.close()

@@ -19,7 +19,8 @@ def _bed(cache, **kw):
 
 def test_a_poured_bed_settles_at_rest_inside_its_holder_and_is_cached(scene, tmp_path):
     from yade import O
-    from yadebreak import poured_bed, scenes
+    from yadebreak.scenes import poured_bed
+    from yadebreak import scenes
     brk, info = _bed(tmp_path)
     settled = info["settled"]
     n = len(info["particles"])
@@ -53,7 +54,7 @@ def test_poured_only_for_several_layers(scene, tmp_path):
 def test_the_run_reports_its_bed_and_rolling_friction(scene, tmp_path):
     """summary.json: bed_packing, the bed's kinetic energy at the ball's touch (a settled bed is
     at rest: below 1e-6 of the impact energy) and the rolling friction of each pair."""
-    from yadebreak import bed
+    from yadebreak.runs import bed
     args = argparse.Namespace(material="copper_ore", size=SIZE, rings=1, layers=3, energy=1.0,
                               speed=0.0, seed=1, time_step_fraction=0.05, dmin=0.0,
                               global_damping=0.0, dummies="ledger", read_period="fast",
@@ -70,7 +71,8 @@ def test_the_run_reports_its_bed_and_rolling_friction(scene, tmp_path):
 
 def _run(tmp_path, name, **kw):
     from yade import O
-    from yadebreak import bed, coupling
+    from yadebreak.runs import bed
+    from yadebreak import coupling
     coupling.forget()
     O.reset()
     values = dict(material="copper_ore", size=SIZE, rings=2, layers=1, energy=1.0, speed=0.0,

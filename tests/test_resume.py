@@ -72,7 +72,8 @@ def test_a_bed_killed_after_its_checkpoint_resumes_to_the_same_run(scene, tmp_pa
     summary is the uninterrupted one's, its events are the same events (kind, body, step), their
     numbers equal to round-off (O.load rebuilds YADE's interaction list in another order, so
     forces are summed in another order), and no event or frame of the killed run is left."""
-    from yadebreak import bed, coupling
+    from yadebreak.runs import bed
+    from yadebreak import coupling
 
     def run(out, **changes):
         coupling.forget()
@@ -117,7 +118,7 @@ def test_zeroed_overlaps_go_on_after_a_reload_as_if_never_saved(scene, tmp_path)
     reads it before: it would make NaN forces) nor which pairs sleep and since when."""
     from yade import utils
     from yadebreak import coupling
-    from yadebreak.scenes import hertz_engines
+    from yadebreak.scenes.impacts import hertz_engines
     ip2, _ = coupling.add_materials({"ore": "copper_ore", "steel": "steel"})
     wall = scene.bodies.append(utils.wall(0.0, axis=2, sense=1, material="steel"))
     low = scene.bodies.append(utils.sphere((0, 0, 2.7e-3), 3e-3, material="ore"))

@@ -16,7 +16,8 @@ def _rolling_sphere(scene, plate, v0, radius=0.01, stiffness_scale=1e-3):
     `plate` ("steel": the particle-steel pair; "ore": particle-particle), resting at its
     equilibrium overlap under gravity. Returns (sphere, rolling friction of the pair)."""
     from yade import utils
-    from yadebreak import coupling, placement, scenes
+    from yadebreak import coupling, scenes
+    from yadebreak.model import placement
     from yadebreak.coupling.scene_materials import rolling_friction
     labels = {"ore": "copper_ore", "steel": "steel"}
     ip2, mats = coupling.add_materials(labels, stiffness_scale=stiffness_scale)

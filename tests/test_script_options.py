@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from yadebreak.scriptargs import ParamError, numbers, number, script_params
+from yadebreak.tools.options import ParamError, numbers, number, script_params
 
 ROOT = Path(__file__).resolve().parent.parent
 PYTHON = "/usr/bin/python3"

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from yadebreak import sweep
+from yadebreak.tools import sweep
 
 ROOT = Path(__file__).resolve().parent.parent
 SCRIPT = ROOT / "scripts" / "single_impact.py"

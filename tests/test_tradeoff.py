@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from yadebreak import tradeoff as to
+from yadebreak.tools import tradeoff as to
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -11,9 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import families, model
-from .materials import MaterialError, available_materials, load_material
-from .scriptargs import (DEBUG, ScriptParser, add_params, fail, integer, join_negative_values,
+from yadebreak.model import families
+from yadebreak import model
+from yadebreak.model.materials import MaterialError, available_materials, load_material
+from yadebreak.tools.options import (DEBUG, ScriptParser, add_params, fail, integer, join_negative_values,
                          number, read_params, text)
 
 
@@ -99,7 +100,7 @@ def list_materials(_args):
 
 def print_options(_args):
     """The engine's options as Markdown (docs/options.md is this output)."""
-    from .coupling.config import options_markdown
+    from yadebreak.coupling.config import options_markdown
     print(OPTIONS_HEADER + options_markdown())
 
 
@@ -114,8 +115,8 @@ value, the accepted range and the unit. Written by `python3 -m yadebreak options
 
 
 def sweep(args):
-    """Run a yade-batch table's lines as Dask tasks (yadebreak.sweep)."""
-    from . import sweep as sw
+    """Run a yade-batch table's lines as Dask tasks (yadebreak.tools.sweep)."""
+    from yadebreak.tools import sweep as sw
     options = _key_values(args.jobqueue, "--jobqueue")
     try:
         status = sw.run_sweep(args.table, args.script, args.out, scheduler=args.scheduler,
@@ -130,7 +131,7 @@ def sweep(args):
 
 def gather(args):
     """sweep.csv from the runs of a table in --out (a yade-batch sweep's out/sweep, say)."""
-    from . import sweep as sw
+    from yadebreak.tools import sweep as sw
     try:
         path = sw.gather(args.out, sw.read_table(args.table))
     except sw.SweepError as exc:
@@ -153,8 +154,8 @@ follow SCRIPT and reach every run."""
 
 def tradeoff_command(argv):
     """`python -m yadebreak tradeoff`: its own parser, as the script's options pass through."""
-    from . import tradeoff as to
-    from .sweep import SweepError
+    from yadebreak.tools import tradeoff as to
+    from yadebreak.tools.sweep import SweepError
     parser = ScriptParser(prog="python -m yadebreak tradeoff", usage=TRADEOFF_USAGE,
                           allow_abbrev=False)
     parser.add_argument("script", help="the YADE script (takes --seed, --out and the options)")
@@ -200,8 +201,8 @@ def _key_values(text_value, option):
 
 
 def _grind(args):
-    """`grind`: the mechanistic mill model (yadebreak.grinding); its input errors as one line."""
-    from .grinding import cli
+    """`grind`: the mechanistic mill model (yadebreak.tools.grinding); its input errors as one line."""
+    from yadebreak.tools.grinding import cli
     try:
         return cli.grind(args)
     except (cli.SpectraError, cli.FeedError, cli.GrindingError) as exc:
@@ -258,7 +259,7 @@ def main(argv=None):
     if argv[:1] == ["tradeoff"]:
         return tradeoff_command(argv[1:])
     if argv[:1] == ["fit"]:                # DATA... takes several files: its own parser
-        from .calibration.cli import main as fit_main
+        from yadebreak.tools.calibration.cli import main as fit_main
         return fit_main(argv[1:])
     parser = ScriptParser(prog="python -m yadebreak")
     sub = parser.add_subparsers(dest="command", required=True)

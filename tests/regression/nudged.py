@@ -4,7 +4,7 @@
     yade -n -x tests/regression/nudged.py SEED scripts/NAME.py [options ...]
 
 When the script's scene is built, just before the breakage model is attached to it (each scene
-builder of yadebreak/scenes.py calls attach() last), every non-zero component of every dynamic
+builder of yadebreak/scenes/ calls attach() last), every non-zero component of every dynamic
 body's position and velocity moves by one unit in the last place (np.nextafter), up or down as
 drawn from numpy.random.default_rng(SEED). A position of 2.75e-3 m moves by 4e-19 m: a difference
 of the size another CPU's rounding (libm, SIMD sums) makes in the first steps.
@@ -43,9 +43,10 @@ def run(seed, script, *options):
     engines' labels), every scene nudged; exit with a message if it built none."""
     sys.argv = [script, *options]
     sys.path.insert(0, str(Path(script).resolve().parent.parent))
-    from yadebreak import scenes
-    from yadebreak.coupling._yade import O
-    hook = scenes.attach = nudging(scenes.attach, int(seed), O)   # looked up at each call
+    from yadebreak.scenes import beds, impacts
+    from yadebreak.coupling.yade_api import O
+    hook = nudging(impacts.attach, int(seed), O)
+    impacts.attach = beds.attach = hook               # looked up at each call
     main = sys.modules["__main__"].__dict__
     main["__file__"] = script
     exec(compile(Path(script).read_text(), script, "exec"), main)

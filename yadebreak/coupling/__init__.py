@@ -13,7 +13,7 @@ config.py holds the options. config, state, contacts, criteria and judging never
 """
 from importlib import import_module
 
-from .config import AttachError, Config, options_markdown
+from yadebreak.coupling.config import AttachError, Config, options_markdown
 
 _NEED_YADE = {"attach": "engine", "controller_of": "engine", "detach": "engine", "forget": "engine",
               "load_checkpoint": "engine", "run_steps": "engine", "save": "engine",

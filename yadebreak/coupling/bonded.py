@@ -29,11 +29,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import bonds, placement
-from ..intervals import Interval
-from . import engine
-from ._yade import O, utils, wrapper as _w
-from .config import AttachError
+from yadebreak.model import bonds, placement
+from yadebreak.model.intervals import Interval
+from yadebreak.coupling import engine
+from yadebreak.coupling.yade_api import O, utils, wrapper as _w
+from yadebreak.coupling.config import AttachError
 
 #: stresses at or above this fraction of a bond's strength are counted (the document's Fig. 18)
 WATCH_LEVEL = 0.8

@@ -9,7 +9,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
-from ..intervals import Interval
+from yadebreak.model.intervals import Interval
 
 
 class AttachError(RuntimeError):

@@ -20,7 +20,7 @@ from itertools import chain
 
 import numpy as np
 
-from .. import model
+from yadebreak import model
 
 #: while the rows are at most this many a read goes contact by contact on Python scalars, beyond
 #: with numpy: measured, the scalar path costs about 1.7 us per contact, the numpy one about

@@ -12,15 +12,15 @@ import warnings
 
 import numpy as np
 
-from .. import families, reports
-from ._yade import O, utils
-from .contacts import ContactReader
-from .criteria import criterion_for
-from .judging import Judge
-from .replacement import Replacer
-from .state import BREAKABLE, BROKEN, UNBREAKABLE, BodyRow, EngineState
-from .stepping import FragmentDamping, ReadSchedule, SmallestBreakable, TimeStep
-from .zeroing import OverlapZeroing
+from yadebreak.model import families, reports
+from yadebreak.coupling.yade_api import O, utils
+from yadebreak.coupling.contacts import ContactReader
+from yadebreak.coupling.criteria import criterion_for
+from yadebreak.coupling.judging import Judge
+from yadebreak.coupling.replacement import Replacer
+from yadebreak.coupling.state import BREAKABLE, BROKEN, UNBREAKABLE, BodyRow, EngineState
+from yadebreak.coupling.stepping import FragmentDamping, ReadSchedule, SmallestBreakable, TimeStep
+from yadebreak.coupling.zeroing import OverlapZeroing
 
 
 class YadebreakWarning(RuntimeWarning):

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import model
+from yadebreak import model
 
 
 @dataclass

@@ -11,7 +11,7 @@ from itertools import repeat
 
 import numpy as np
 
-from .criteria import judge_all
+from yadebreak.coupling.criteria import judge_all
 
 #: up to this many bodies in a read are judged one by one: measured, the array path costs about
 #: 15 us per read plus 0.15 us per body, the scalar one 0.8 us per body (equal near 24 bodies)

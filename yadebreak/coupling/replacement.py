@@ -9,9 +9,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import model, placement
-from ._yade import O, utils, wrapper
-from .state import BREAKABLE, DUMMY, UNBREAKABLE
+from yadebreak import model
+from yadebreak.model import placement
+from yadebreak.coupling.yade_api import O, utils, wrapper
+from yadebreak.coupling.state import BREAKABLE, DUMMY, UNBREAKABLE
 
 
 @dataclass

@@ -5,8 +5,8 @@ from __future__ import annotations
 import heapq
 import math
 
-from .. import placement
-from ._yade import O, find_engine, utils, wrapper
+from yadebreak.model import placement
+from yadebreak.coupling.yade_api import O, find_engine, utils, wrapper
 
 #: read_period="fast" never waits longer than this many steps between reads.
 FAST_MAX_PERIOD = 200

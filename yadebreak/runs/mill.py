@@ -1,0 +1,496 @@
+"""The laboratory batch ball mill behind scripts/ball_mill.py (coupling layer: runs YADE, writes
+outputs). A drum of steel facets with lifter bars, turned about the x axis by YADE's
+RotationEngine; steel balls and a breakable ore charge; gravity along -z.
+
+The run records, every --sample-interval seconds of simulated time, the product size distribution
+(fines included), the drum's torque and the charge's centre of mass, and writes the size
+distribution against time, the first-order breakage rate of the feed size, the mill power from the
+torque beside two checks (the torque-arm model and Bond's equation), a picture of the charge seen
+along the axis and a ParaView series.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from yadebreak import coupling, scenes
+from yadebreak.model import milling
+from yadebreak.runs import paraview
+from yadebreak.coupling.yade_api import O, utils, wrapper as _w
+from yadebreak.coupling.stepping import smallest_rayleigh_time
+from yadebreak.tools.options import (ScriptError, check_not_finished, check_resume_arguments, mark_finished,
+                         mark_started, partial_outputs_on_failure, progress, read_checkpoint,
+                         read_period_value, resume_arguments, run_wall_time, stop_point,
+                         stop_points, time_left, write_atomic)
+
+PACKING = 0.6                    # solid fraction of a settled charge (bulk volume -> solid volume)
+SETTLE_TIME = 0.25               # s of settling under gravity, drum still, before the engine
+
+
+# -- geometry ---------------------------------------------------------------------------------------
+def drum_profile(radius, lifters, lifter_height, lifter_width, segments=48):
+    """The drum's cross-section (y, z points, m): a circle of `segments` chords with `lifters`
+    rectangular bars (height and width in m) standing inward, evenly spaced, closed."""
+    half = 0.5 * lifter_width / radius              # half the angle a lifter's foot spans
+    points = []
+    for k in range(segments):
+        theta0, theta1 = 2 * math.pi * k / segments, 2 * math.pi * (k + 1) / segments
+        points.append((radius * math.cos(theta0), radius * math.sin(theta0)))
+        for j in range(lifters):
+            at = 2 * math.pi * (j + 0.5) / lifters
+            if theta0 <= at < theta1:
+                inner = radius - lifter_height
+                for angle, r in ((at - half, radius), (at - half, inner), (at + half, inner),
+                                 (at + half, radius)):
+                    points.append((r * math.cos(angle), r * math.sin(angle)))
+    return points + [points[0]]
+
+
+def drum_facets(profile, length, material):
+    """Facets of the drum's shell: two per chord of the profile, between x = -length/2 and
+    length/2. The end walls are planes (end_walls): a fan of thin facets from the axis gave NaN
+    contacts with YADE 2023.02's facet geometry (measured: a ball at the end wall's centre)."""
+    x0, x1 = -0.5 * length, 0.5 * length
+    facets = []
+    for (ya, za), (yb, zb) in zip(profile[:-1], profile[1:]):
+        a0, b0, a1, b1 = (x0, ya, za), (x0, yb, zb), (x1, ya, za), (x1, yb, zb)
+        facets += [utils.facet((a0, b0, b1), material=material),
+                   utils.facet((a0, b1, a1), material=material)]
+    return facets
+
+
+def end_walls(length, material):
+    """The drum's two end walls, planes x = -length/2 and x = length/2, still (their friction on
+    the charge is the only difference from walls that turn with the shell)."""
+    return [utils.wall(-0.5 * length, axis=0, sense=1, material=material),
+            utils.wall(0.5 * length, axis=0, sense=-1, material=material)]
+
+
+def charge_positions(radius, length, clearance, ball_size, balls, ore_size, ores, rng):
+    """Centres (m) of `balls` balls and `ores` ore particles, as low in the drum as they go: the
+    lowest points of a jittered lattice inside the drum (at least `clearance` from the shell), the
+    balls first, then the ore among them without overlap. Raises ScriptError if they do not fit."""
+    def lattice(size):
+        step = 1.02 * size
+        reach = radius - clearance - 0.5 * size
+        xs = np.arange(-0.5 * length + 0.51 * size, 0.5 * length - 0.51 * size + 1e-12, step)
+        ys = np.arange(-reach, reach + 1e-12, step)
+        grid = np.array(np.meshgrid(xs, ys, ys, indexing="ij")).reshape(3, -1).T
+        inside = np.hypot(grid[:, 1], grid[:, 2]) <= reach
+        grid = grid[inside]
+        return grid[np.lexsort((rng.random(len(grid)), grid[:, 2]))]     # lowest first
+    ball_at = lattice(ball_size)[:balls]
+    ore_at = lattice(ore_size)
+    if len(ore_at) and len(ball_at):
+        gap = np.min(np.linalg.norm(ore_at[:, None, :] - ball_at[None, :, :], axis=2), axis=1)
+        ore_at = ore_at[gap > 0.51 * (ball_size + ore_size)]
+    ore_at = ore_at[:ores]
+    if len(ball_at) < balls or len(ore_at) < ores:
+        raise ScriptError(f"the charge does not fit: {len(ball_at)} of {balls} balls and "
+                          f"{len(ore_at)} of {ores} ore particles placed; lower --ball-filling or "
+                          "--ore-filling, or use a larger drum")
+    return ball_at, ore_at
+
+
+def charge_counts(args):
+    """(balls, ore particles) for the fillings: a filling is the bulk volume of the charge over the
+    drum's volume; the bulk is PACKING solid."""
+    volume = math.pi * (0.5 * args.drum_diameter) ** 2 * args.drum_length
+    ball_volume = math.pi / 6 * args.ball_size ** 3
+    ore_volume = math.pi / 6 * args.size ** 3
+    return (max(1, round(args.ball_filling * volume * PACKING / ball_volume)),
+            max(1, round(args.ore_filling * volume * PACKING / ore_volume)))
+
+
+def check_geometry(args):
+    """Cross-checks of the options that one range cannot say (one line each)."""
+    radius = 0.5 * args.drum_diameter
+    if args.ball_size >= radius:
+        raise ScriptError(f"--ball-size = {args.ball_size:g}: must be < the drum's radius "
+                          f"{radius:g} (m)")
+    if args.lifter_height >= 0.5 * radius:
+        raise ScriptError(f"--lifter-height = {args.lifter_height:g}: must be < half the drum's "
+                          f"radius, {0.5 * radius:g} (m)")
+    if args.size >= args.ball_size * 2:
+        raise ScriptError(f"--size = {args.size:g}: must be < twice --ball-size, "
+                          f"{2 * args.ball_size:g} (m)")
+
+
+# -- the scene ----------------------------------------------------------------------------------------
+def mill_scene(args, options):
+    """Build the mill, settle the charge with the drum still, attach yadebreak and start the drum.
+    Returns (controller, info)."""
+    O.reset()
+    ip2, mats = coupling.add_materials({"ore": args.material, "steel": "steel"},
+                                       stiffness_scale=args.stiffness_scale)
+    radius = 0.5 * args.drum_diameter
+    profile = drum_profile(radius, args.lifters, args.lifter_height, args.lifter_width)
+    drum = O.bodies.append(drum_facets(profile, args.drum_length, "steel"))
+    ends = O.bodies.append(end_walls(args.drum_length, "steel"))
+    n_balls, n_ore = charge_counts(args)
+    rng = np.random.default_rng(args.seed)
+    ball_at, ore_at = charge_positions(radius, args.drum_length, args.lifter_height,
+                                       args.ball_size, n_balls, args.size, n_ore, rng)
+    balls = [O.bodies.append(utils.sphere(tuple(c), 0.5 * args.ball_size, material="steel"))
+             for c in ball_at]
+    ore = [O.bodies.append(utils.sphere(tuple(c), 0.5 * args.size, material="ore"))
+           for c in ore_at]
+    speed = args.speed * milling.critical_speed(args.drum_diameter, args.ball_size)  # rev/s
+    omega = 2 * math.pi * speed
+    O.engines = scenes.hertz_engines(ip2, gravity=(0.0, 0.0, -9.81), facets=True) + [
+        _w.RotationEngine(rotationAxis=(1, 0, 0), rotateAroundZero=True, zeroPoint=(0, 0, 0),
+                          angularVelocity=0.0, ids=list(drum), label="drum")]
+    # settle with the drum still, damped, before anything is tracked (the fill is not milling)
+    O.dt = args.time_step_fraction * smallest_rayleigh_time()
+    newton = O.engines[-2]
+    newton.damping = 0.5
+    O.run(int(SETTLE_TIME / O.dt), True)
+    newton.damping = 0.0
+    for i in balls + ore:
+        O.bodies[i].state.vel = (0, 0, 0)
+        O.bodies[i].state.angVel = (0, 0, 0)
+    brk = coupling.attach({"ore": args.material}, seed=args.seed, **options)
+    next(e for e in O.engines if isinstance(e, _w.RotationEngine)).angularVelocity = omega
+    info = {"drum": list(drum), "ends": list(ends), "balls": balls, "ore": ore, "omega": omega, "speed_rps": speed,
+            "start_time": O.time,                 # the settling's end: the mill's t = 0
+            "profile": profile, "ball_mass": sum(O.bodies[i].state.mass for i in balls)}
+    return brk, info
+
+
+def drum_torque(drum):
+    """Torque (N m) of the charge on the drum about its axis (x): sum over the drum's facets of
+    (position x force + torque), from the last step's forces."""
+    total = 0.0
+    for i in drum:
+        f, t, p = O.forces.f(i), O.forces.t(i), O.bodies[i].state.pos
+        total += p[1] * f[2] - p[2] * f[1] + t[0]
+    return total
+
+
+def mill_time(info):
+    """Simulated time (s) since the drum started (the settling before it is not milling)."""
+    return O.time - info["start_time"]
+
+
+def charge_state(info):
+    """(mass (kg), horizontal lever arm y of its centre of mass (m)) of every sphere in the drum:
+    balls, ore and fragments (a pass over the bodies, once per sample)."""
+    mass = moment = 0.0
+    for b in O.bodies:
+        if b is not None and b.dynamic:
+            mass += b.state.mass
+            moment += b.state.mass * b.state.pos[1]
+    return mass, (moment / mass if mass else 0.0)
+
+
+PAIR_TYPES = ("ball-ore", "ore-ore", "ore-liner")
+
+
+def pair_type(partner, info):
+    """The kind of contact that brought an ore event's largest energy, from the event's partner
+    id: a ball, the drum (shell, lifters, end walls), another ore sphere; None without one."""
+    if partner < 0:
+        return None
+    if partner in info["ball_set"]:
+        return "ball-ore"
+    if partner in info["liner_set"]:
+        return "ore-liner"
+    return "ore-ore"
+
+
+def collision_spectra(events, info, duration):
+    """Stressing events per second against specific energy (J/kg), per pair type: (bin edges,
+    {pair type: (per bin, at or above each lower edge)}), from the engine's damage and breakage
+    events (each ore stressing event once, at its largest energy, with the contact that brought
+    most of it)."""
+    stressing = [e for e in events if e["kind"] in ("damage", "breakage")]
+    energies = np.array([e["specific_energy"] for e in stressing])
+    positive = energies[energies > 0]
+    low, high = ((positive.min(), positive.max()) if len(positive) else (1e-3, 1.0))
+    edges = np.geomspace(low, high * (1 + 1e-9), 25)
+    spectra = {}
+    for kind in PAIR_TYPES:
+        mine = [e["specific_energy"] for e in stressing
+                if pair_type(e.get("partner", -1), info) == kind]
+        spectra[kind] = milling.event_spectrum(mine, duration, edges)
+    return edges, spectra
+
+
+# -- the run ------------------------------------------------------------------------------------------
+def _options(args, out):
+    read_period = read_period_value(args.read_period)
+    options = dict(time_step_fraction=args.time_step_fraction, dummies="ledger",
+                   read_period=read_period, event_log=str(out / "events.jsonl"))
+    options["dmin"] = args.dmin if args.dmin > 0 else args.size / 3.0
+    return options
+
+
+def sieves_for(args):
+    """The root-2 sieve series from the feed size down to 1/64 of it (m)."""
+    return milling.size_classes(args.size * math.sqrt(2), 13)
+
+
+def _sample(brk, info, loop, args):
+    """One row of the histories: time, the product's mass passing each sieve, the feed class'
+    mass, torque and the charge's lever arm."""
+    sieves = np.array(loop["sieves"])
+    passing = brk.size_distribution(sieves).passing_mass
+    feed = float(brk.size_distribution([args.size * 1.0001]).passing_mass[0]
+                 - brk.size_distribution([args.size / math.sqrt(2)]).passing_mass[0])
+    mass, arm = charge_state(info)
+    loop["times"].append(mill_time(info))
+    loop["passing"].append([float(p) for p in passing])
+    loop["feed_mass"].append(feed)
+    loop["charge_mass"].append(mass)
+    loop["lever_arm"].append(arm)
+
+
+def _start(args, out, say):
+    checkpoint = out / "checkpoint.yade.gz"
+    if getattr(args, "resume", False):
+        check_not_finished(out, args)
+        brk, data = read_checkpoint(checkpoint, lambda path: _loaded(*coupling.load_checkpoint(
+            path)))
+        check_resume_arguments(data["arguments"], args, checkpoint)
+        say(f"resumed from {checkpoint} at t = {mill_time(data['info']):.3f} s")
+        data["loop"]["wall_before_s"] = data["loop"].get("wall_s", 0.0)   # earlier invocations
+        return brk, data["info"], data["loop"]
+    mark_started(out)
+    brk, info = mill_scene(args, _options(args, out))
+    loop = {"initial_mass": brk.total_mass(), "initial_dt": O.dt, "sieves":
+            sieves_for(args).tolist(), "times": [], "passing": [], "feed_mass": [],
+            "charge_mass": [], "lever_arm": [], "torque_time": [], "torque": [],
+            "next_sample": 0.0}
+    say(f"{len(info['balls'])} balls ({1e3 * args.ball_size:g} mm) and {len(info['ore'])} "
+        f"particles of {args.material} ({1e3 * args.size:g} mm) in a {1e3 * args.drum_diameter:g}"
+        f" x {1e3 * args.drum_length:g} mm drum at {60 * info['speed_rps']:.1f} rpm "
+        f"({100 * args.speed:g} % of critical); dt {O.dt:.3g} s")
+    return brk, info, loop
+
+
+def _loaded(brk, data):
+    """A checkpoint's state, its parts checked (a damaged one fails here, before the run)."""
+    for part in ("arguments", "info", "loop"):
+        if not isinstance(data.get(part), dict):
+            raise ValueError(f"its state has no {part!r}")
+    return brk, data
+
+
+def run(args, quiet=False):
+    """Build, run and report one mill. Returns (controller, summary dict)."""
+    check_geometry(args)                          # before anything is written
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.time()
+    say = (lambda m: None) if quiet else progress
+    # SIGINT, SIGTERM from here on: the run ends at its loop's next stop_point, checkpointed
+    with stop_points():
+        brk, info, loop = _start(args, out, say)
+        frames = paraview.series(out / "paraview", brk, args.vtk_interval,
+                                 resume=getattr(args, "resume", False))
+
+        def runtime():                # s: the whole run's, over its invocations (to checkpoints)
+            return run_wall_time(loop, start)
+
+        def partial(end_reason, end_message):
+            _report(brk, info, loop, args, out, runtime(), end_reason, end_message)
+
+        with partial_outputs_on_failure(partial):
+            ended = _mill(brk, info, loop, args, out, start, say, frames)
+    if ended is None:
+        return brk, None
+    brk.finish()
+    frames.close()
+    summary = _report(brk, info, loop, args, out, runtime(), ended, "")
+    mark_finished(out, args)
+    (out / "checkpoint.yade.gz").unlink(missing_ok=True)
+    say(f"done in {summary['runtime_s']:.0f} s: {summary['breakage_events']} breakages, broken "
+        f"mass {100 * summary['broken_mass_fraction']:.2f} % of the ore, mean power "
+        f"{summary['mean_power_W']:.1f} W; outputs in {out}")
+    return brk, summary
+
+
+def _mill(brk, info, loop, args, out, start, say, frames):
+    """Turn the drum for args.duration s of simulated time: samples, torque, progress lines,
+    ParaView frames and checkpoints. "finished", or None if stopped on purpose (--stop-after)."""
+    last_report = last_checkpoint = start
+    batch = 200
+    while mill_time(info) < args.duration:
+        coupling.run_steps(batch)
+        now_s = mill_time(info)
+        loop["torque_time"].append(now_s)
+        loop["torque"].append(drum_torque(info["drum"]))
+        if now_s >= loop["next_sample"]:
+            _sample(brk, info, loop, args)
+            loop["next_sample"] = now_s + args.sample_interval
+        frames()
+        now = time.time()
+        if args.checkpoint_every >= 0 and now - last_checkpoint >= args.checkpoint_every:
+            _checkpoint(out, info, loop, args, start)
+            last_checkpoint = now
+        stop_point(lambda: _checkpoint(out, info, loop, args, start))    # SIGINT, SIGTERM
+        if args.stop_after and now_s >= args.stop_after:
+            return None
+        if now - last_report > 10.0:
+            say(f"t = {now_s:.3f} of {args.duration:g} s, {len(brk.breakage_events)} breakages, "
+                f"{sum(1 for b in O.bodies if b is not None)} bodies, dt {O.dt:.2g} s, wall "
+                f"{now - start:.0f} s, {time_left(now - start, now_s / args.duration)}")
+            last_report = now
+    _sample(brk, info, loop, args)
+    return "finished"
+
+
+def _checkpoint(out, info, loop, args, start):
+    """The scene and the loop's state, with the run's wall time so far (this invocation began
+    at `start`): --resume 1 goes on from it."""
+    loop["wall_s"] = run_wall_time(loop, start)
+    coupling.save_checkpoint(out / "checkpoint.yade.gz", {
+        "loop": loop, "info": info, "arguments": resume_arguments(args)})
+
+
+def _report(brk, info, loop, args, out, runtime, end_reason, end_message):
+    """summary.json, the histories (CSV) and the plots."""
+    info = {**info, "ball_set": set(info["balls"]),
+            "liner_set": set(info["drum"]) | set(info.get("ends", ()))}
+    times = np.array(loop["times"])
+    ore_mass = loop["initial_mass"]
+    lower = args.size / math.sqrt(2)            # the feed class' lower sieve
+    broken = float(brk.size_distribution([lower]).passing_mass[0])
+    torque = np.array(loop["torque"])
+    power = -torque * info["omega"]             # the motor's power: against the charge's torque
+    steady = np.array(loop["torque_time"]) >= 0.25 * args.duration   # past the start-up
+    mean_power = float(power[steady].mean()) if steady.any() else float("nan")
+    arm = np.array(loop["lever_arm"])
+    charge = np.array(loop["charge_mass"])
+    sample_steady = times >= 0.25 * args.duration
+    torque_arm = (float(milling.charge_torque_power(charge[sample_steady], np.abs(
+        arm[sample_steady]), info["omega"]).mean()) if sample_steady.any() else float("nan"))
+    bond = float(milling.bond_mill_power_per_ball_mass(args.drum_diameter, args.ball_filling,
+                                                       args.speed)) * info["ball_mass"]
+    feed = np.array(loop["feed_mass"])
+    try:
+        rate, rate_error = milling.first_order_breakage_rate(times, feed)
+    except ValueError:
+        rate, rate_error = float("nan"), float("nan")
+    events = brk.events
+    duration = mill_time(info)
+    edges, spectra = (collision_spectra(events, info, duration) if duration > 0
+                      else (None, {}))
+    summary = {
+        "material": args.material, "size": args.size, "ball_size": args.ball_size,
+        "drum_diameter": args.drum_diameter, "drum_length": args.drum_length,
+        "lifters": args.lifters, "speed_fraction": args.speed,
+        "speed_rpm": 60 * info["speed_rps"], "ball_filling": args.ball_filling,
+        "ore_filling": args.ore_filling, "stiffness_scale": args.stiffness_scale,
+        "seed": args.seed, "balls": len(info["balls"]), "ore_particles": len(info["ore"]),
+        "bodies_start": len(info["balls"]) + len(info["ore"]) + len(info["drum"]) + 2,
+        "bodies_end": sum(1 for b in O.bodies if b is not None),
+        "breakage_events": sum(e["kind"] == "breakage" for e in events),
+        "damage_events": sum(e["kind"] == "damage" for e in events),
+        "initial_mass": ore_mass, "final_mass": brk.total_mass(),
+        "mass_relative_error": abs(brk.total_mass() - ore_mass) / ore_mass,
+        "broken_mass": broken, "broken_mass_fraction": broken / ore_mass,
+        "feed_breakage_rate": rate, "feed_breakage_rate_error": rate_error,
+        "stressing_events_per_second": {kind: float(rates[1][0]) for kind, rates
+                                        in spectra.items()},
+        "mean_power_W": mean_power, "torque_arm_power_W": torque_arm,
+        "bond_power_W": bond, "ball_mass": info["ball_mass"],
+        "simulated_time": mill_time(info), "steps": O.iter, "initial_dt": loop["initial_dt"],
+        "final_dt": O.dt, "runtime_s": runtime,
+        "throughput_s_per_hour": 3600.0 * mill_time(info) / runtime if runtime > 0 else None,
+        "end_reason": end_reason, "end_message": end_message}
+    write_atomic(out / "summary.json", json.dumps(summary, indent=2))
+    sieves = np.array(loop["sieves"])
+    with open(out / "size_distribution.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["time_s"] + [f"passing_{1e3 * s:.4g}mm_percent" for s in sieves])
+        for t, p in zip(times, loop["passing"]):
+            w.writerow([t] + [100 * m / ore_mass for m in p])
+    with open(out / "breakage_rate.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["time_s", "feed_class_mass_kg", "feed_class_fraction"])
+        w.writerows((t, m, m / feed[0] if len(feed) and feed[0] > 0 else float("nan"))
+                    for t, m in zip(times, feed))
+    with open(out / "power.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["time_s", "torque_Nm", "power_W"])
+        w.writerows(zip(loop["torque_time"], torque, power))
+    if edges is not None:
+        with open(out / "collision_spectra.csv", "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["energy_low_J_per_kg", "energy_high_J_per_kg"]
+                       + [f"{kind}_{what}" for kind in PAIR_TYPES
+                          for what in ("per_s", "at_or_above_per_s")])
+            for k in range(len(edges) - 1):
+                w.writerow([edges[k], edges[k + 1]] + [float(v) for kind in PAIR_TYPES
+                                                       for v in (spectra[kind][0][k],
+                                                                 spectra[kind][1][k])])
+    _plots(out, summary, loop, info, power, edges, spectra)
+    return summary
+
+
+def _plots(out, summary, loop, info, power, edges, spectra):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Polygon
+    times, sieves = np.array(loop["times"]), np.array(loop["sieves"])
+    ore = summary["initial_mass"]
+    fig, axes = plt.subplots(1, 4, figsize=(20, 4.5))
+    picks = sorted(set(np.linspace(0, len(times) - 1, min(5, len(times))).astype(int)))
+    for k in picks:
+        axes[0].semilogx(1e3 * sieves, 100 * np.array(loop["passing"][k]) / ore, "o-", ms=3,
+                         label=f"t = {times[k]:.2f} s")
+    axes[0].set(xlabel="size (mm)", ylabel="ore passing (%)", title="size distribution")
+    axes[0].legend(fontsize=8)
+    feed = np.array(loop["feed_mass"])
+    if len(feed) and feed[0] > 0:
+        axes[1].plot(times, feed / feed[0], "o", ms=3, label="simulation")
+        rate = summary["feed_breakage_rate"]
+        if math.isfinite(rate):
+            axes[1].plot(times, np.exp(-rate * (times - times[0])), "k-",
+                         label=f"first order, S = {rate:.3g} 1/s")
+    axes[1].set(xlabel="time (s)", ylabel="feed class mass remaining (-)",
+                title="breakage rate of the feed size")
+    axes[1].legend(fontsize=8)
+    axes[2].plot(loop["torque_time"], power, lw=0.5, c="0.6", label="from the drum's torque")
+    axes[2].axhline(summary["mean_power_W"], c="C0", label=f"mean {summary['mean_power_W']:.1f} W")
+    axes[2].axhline(summary["torque_arm_power_W"], c="C2", ls="--",
+                    label=f"torque arm M g x w: {summary['torque_arm_power_W']:.1f} W")
+    axes[2].axhline(summary["bond_power_W"], c="C3", ls=":",
+                    label=f"Bond's equation: {summary['bond_power_W']:.1f} W")
+    axes[2].set(xlabel="time (s)", ylabel="power (W)", title="mill power")
+    axes[2].legend(fontsize=8)
+    for kind, (_, above) in (spectra or {}).items():
+        if above[0] > 0:
+            axes[3].loglog(edges[:-1], above, drawstyle="steps-post", label=kind)
+    axes[3].set(xlabel="specific energy Ek'/m (J/kg)", ylabel="stressing events per second >= it",
+                title="collision energy spectra")
+    if any(above[0] > 0 for _, above in (spectra or {}).values()):
+        axes[3].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / "mill.png", dpi=110)
+    plt.close(fig)
+    # the charge seen along the axis
+    fig, ax = plt.subplots(figsize=(6, 6))
+    angle = mill_time(info) * info["omega"]   # the drum's profile has turned with it
+    c, s = math.cos(angle), math.sin(angle)
+    profile = [(c * y - s * z, s * y + c * z) for y, z in info["profile"]]
+    ax.add_patch(Polygon(1e3 * np.array(profile), closed=True, fill=False, ec="k"))
+    balls = set(info["balls"])
+    for b in O.bodies:
+        if b is not None and isinstance(b.shape, _w.Sphere):
+            colour = "0.55" if b.id in balls else "tab:orange"
+            ax.add_patch(Circle((1e3 * b.state.pos[1], 1e3 * b.state.pos[2]),
+                                1e3 * b.shape.radius, fc=colour, ec="k", lw=0.2, alpha=0.8))
+    reach = 550 * summary["drum_diameter"]
+    ax.set(xlim=(-reach, reach), ylim=(-reach, reach), aspect="equal", xlabel="y (mm)",
+           ylabel="z (mm)", title=f"charge at t = {mill_time(info):.2f} s (grey balls, orange ore)")
+    fig.tight_layout()
+    fig.savefig(out / "charge.png", dpi=110)
+    plt.close(fig)

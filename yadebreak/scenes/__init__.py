@@ -1,0 +1,12 @@
+"""Builders of YADE scenes (YADE layer): each returns the attached engine and what the job
+needs to measure. A new scene goes here; the job that runs it goes in yadebreak.runs.
+
+impacts     particles shot at a target, repeated impacts, the drop weight; the shared engines
+beds        a ball on a bed of particles (lattice or poured)
+poured_bed  beds poured and settled under gravity, and their cache
+"""
+from yadebreak.scenes.impacts import (drop_weight_scene, hertz_engines, impact_again,  # noqa: F401
+                                      impact_scene, run_scenes, run_until_rebound, scene_seed,
+                                      single_impacts)
+from yadebreak.scenes.beds import (BALL_DIAMETER, BALL_MASS, bed_impact_scene,  # noqa: F401
+                                   hex_bed_positions, hold_release)
