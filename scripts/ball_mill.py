@@ -20,41 +20,11 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.tools.options import (checkpointed_run_options, integer,  # noqa: E402
-                                  material_option, number, read_period_option,
-                                  script_params, size_option, time_step_option)
+from yadebreak.runs import job_options  # noqa: E402
 
-args = script_params([
-    material_option("the ore", "limestone"),     # the softest ore of the library: breaks in 1 s
-    size_option(8e-3),
-    number("ball_size", 25e-3, "m", "diameter of the steel balls", lo=0, lo_open=True, hi=0.5),
-    number("drum_diameter", 0.25, "m", "inside diameter of the drum (to the shell)", lo=0,
-           lo_open=True, hi=10),
-    number("drum_length", 0.1, "m", "length of the drum (the charge scales with it)", lo=0,
-           lo_open=True, hi=10),
-    integer("lifters", 8, "lifter bars along the shell", lo=0, hi=64),
-    number("lifter_height", 10e-3, "m", "height of a lifter bar", lo=0),
-    number("lifter_width", 10e-3, "m", "width of a lifter bar", lo=0, lo_open=True),
-    number("speed", 0.75, "-", "rotation speed as a fraction of the critical speed", lo=0,
-           hi=1, lo_open=True, hi_open=True),
-    number("ball_filling", 0.3, "-", "bulk volume of the balls over the drum's volume", lo=0,
-           hi=0.5, lo_open=True),
-    number("ore_filling", 0.1, "-", "bulk volume of the ore over the drum's volume", lo=0,
-           hi=0.5, lo_open=True),
-    number("duration", 1.0, "s", "simulated time the drum turns", lo=0, lo_open=True),
-    number("stiffness_scale", 1e-3, "-", "factor on every Young's modulus (mill DEM's usual "
-           "reduction, for a longer time step)", lo=0, hi=1, lo_open=True),
-    time_step_option(),
-    number("dmin", 0.0, "m", "smallest resolved fragment; finer progeny goes to the ledger "
-           "(0: --size / 3)", lo=0),
-    read_period_option("fast"),
-    integer("seed", 1, "random seed", lo=0),
-    number("sample_interval", 0.02, "s", "simulated time between samples of the size "
-           "distribution and the charge", lo=0, lo_open=True),
-    *checkpointed_run_options(0.05, "out/ball_mill"),
-], __doc__)
+args = job_options.read("ball_mill", __doc__)
 
 from yadebreak.runs import mill  # noqa: E402
-from yadebreak.tools.options import run_script  # noqa: E402
+from yadebreak.tools.lifecycle import run_script  # noqa: E402
 
 brk, summary = run_script(mill.run, args) or (None, None)   # None: resumed a finished run

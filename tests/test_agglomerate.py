@@ -216,7 +216,7 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
     from yade import O
     from yadebreak.runs import agglomerate
     from yadebreak.coupling import bonded
-    from yadebreak.tools.options import RunFinished, ScriptError
+    from yadebreak.tools.lifecycle import RunFinished, ScriptError
     small = dict(particles=120, duration=1.5e-4)     # 89 of 431 bonds break, by 0.1 ms
     whole = agglomerate.run(_args(tmp_path / "whole", checkpoint_every=-1.0, **small), quiet=True)
     cut = tmp_path / "cut"
@@ -255,7 +255,7 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
 
 def test_a_damaged_checkpoint_is_refused_in_one_line(scene, tmp_path):
     from yadebreak.runs import agglomerate
-    from yadebreak.tools.options import ScriptError
+    from yadebreak.tools.lifecycle import ScriptError
     (tmp_path / "checkpoint.yade.gz").write_bytes(b"\x1f\x8b\x08garbage")
     with pytest.raises(ScriptError, match=r"checkpoint.yade.gz is damaged .*run again without "
                                           r"--resume$"):

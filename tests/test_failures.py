@@ -13,8 +13,9 @@ import numpy as np
 import pytest
 
 from yadebreak.model import reports
-from yadebreak.tools import options as scriptargs
-from yadebreak.tools.options import partial_outputs_on_failure, time_left
+from yadebreak.tools import lifecycle
+from yadebreak.tools.lifecycle import partial_outputs_on_failure, time_left
+from yadebreak.tools import options
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -49,9 +50,9 @@ def test_a_failure_writes_the_partial_outputs_and_goes_on():
         with partial_outputs_on_failure(lambda *end: written.append(end)):
             raise KeyboardInterrupt
     assert written[-1][0] == "interrupted"
-    with pytest.raises(scriptargs.StopRequested):       # --stop-after stands for a kill: nothing
+    with pytest.raises(lifecycle.StopRequested):       # --stop-after stands for a kill: nothing
         with partial_outputs_on_failure(lambda *end: written.append(end)):
-            raise scriptargs.StopRequested()
+            raise lifecycle.StopRequested()
     assert len(written) == 2
 
 
@@ -60,11 +61,9 @@ def test_run_script_turns_a_failure_into_an_exit_code_and_a_line(capsys, excepti
     def main():
         raise exception
     shown = warnings.showwarning
-    try:
-        with pytest.raises(SystemExit) as ended:
-            scriptargs.run_script(main)
-    finally:
-        warnings.showwarning = shown
+    with pytest.raises(SystemExit) as ended:
+        lifecycle.run_script(main)
+    assert warnings.showwarning is shown            # its warnings' display was scoped to the run
     assert ended.value.code == code
     said = capsys.readouterr()
     assert ("the run failed (RuntimeError: boom)" in said.err if code == 1
@@ -84,17 +83,13 @@ def test_a_warning_is_shown_once_naming_the_scripts_own_option(capsys):
         "energy jumped: read every step (--read-period 1) for an accurate t10'")
     assert "(an attach() option)" in warning.for_script(set())
 
-    scriptargs.script_params([scriptargs.integer("read_period", 1, "how often", lo=1)], argv=[])
+    options.script_params([options.integer("read_period", 1, "how often", lo=1)], argv=[])
     shown = warnings.showwarning
-    try:
-        scriptargs._show_warnings_once()
-        with warnings.catch_warnings():
-            warnings.simplefilter("always")
-            warnings.showwarning = scriptargs.warnings.showwarning
-            for _ in range(3):       # e.g. three scenes of a run, each with its own controller
-                warnings.warn(YadebreakWarning("jump", "energy jumped", remedies))
-    finally:
-        warnings.showwarning = shown
+    with lifecycle.warnings_shown_once():           # what run_script does around a run
+        warnings.simplefilter("always")
+        for _ in range(3):           # e.g. three scenes of a run, each with its own controller
+            warnings.warn(YadebreakWarning("jump", "energy jumped", remedies))
+    assert warnings.showwarning is shown            # scoped: Python's display is back after it
     lines = [line for line in capsys.readouterr().err.splitlines() if "WARNING" in line]
     assert lines == ["[yadebreak] WARNING: energy jumped: read every step (--read-period 1) "
                      "(shown once)"]
@@ -166,7 +161,7 @@ def test_gather_sweep_gathers_a_partial_sweep(tmp_path):
     assert "unfinished: a_s4 (no summary.json)" in proc.stdout
     assert "unfinished: a_s5 (not run)" in proc.stdout
     assert "2 runs in 1 configurations (3 unfinished" in proc.stdout
-    rows = (tmp_path / "report" / "sweep.csv").read_text().splitlines()
+    rows = (tmp_path / "report" / "configurations.csv").read_text().splitlines()
     assert len(rows) == 2 and ",2," in rows[1]          # one configuration, 2 runs
     # its error bar (mean 0.2 g, sd 0.1 g) is drawn; with sd > mean it would stop at zero
     assert (tmp_path / "report" / "broken_mass.png").stat().st_size > 0
@@ -195,11 +190,7 @@ def test_a_small_bed_says_why_it_took_longer(scene, tmp_path, capsys):
 # -- faults lose nothing: one run per --out, signals, damaged files, a full disk, workers ----------
 def _run_script(main, args):
     """run_script in this process: (exit code or None, stdout, stderr) via capsys by the caller."""
-    shown = warnings.showwarning
-    try:
-        return scriptargs.run_script(main, args)
-    finally:
-        warnings.showwarning = shown
+    return lifecycle.run_script(main, args)
 
 
 def _one_line(text):
@@ -212,7 +203,7 @@ def test_a_second_run_into_an_out_in_use_is_refused_and_a_killed_one_leaves_no_l
                                                                                     capsys):
     holder = subprocess.Popen(
         ["nice", "-n", "5", sys.executable, "-c", "import sys, time; sys.path.insert(0, "
-         "sys.argv[1]); from yadebreak.tools.options import lock_out; lock_out(sys.argv[2]); "
+         "sys.argv[1]); from yadebreak.tools.lifecycle import lock_out; lock_out(sys.argv[2]); "
          "print('locked', flush=True); time.sleep(120)", str(ROOT), str(tmp_path)],
         stdout=subprocess.PIPE, text=True)
     try:
@@ -228,7 +219,7 @@ def test_a_second_run_into_an_out_in_use_is_refused_and_a_killed_one_leaves_no_l
         holder.kill()                                        # kill -9: the kernel frees the lock
         holder.wait()
     assert _run_script(lambda args: "ran", argparse.Namespace(out=str(tmp_path))) == "ran"
-    assert scriptargs._LOCKS == {}                 # released when the run is over
+    assert lifecycle._LOCKS == {}                 # released when the run is over
 
 
 def test_a_signal_ends_the_run_as_interrupted_with_its_outputs(tmp_path, capsys):
@@ -239,13 +230,13 @@ def test_a_signal_ends_the_run_as_interrupted_with_its_outputs(tmp_path, capsys)
     written, saved, steps = [], [], []
 
     def main(args):
-        with scriptargs.partial_outputs_on_failure(lambda *end: written.append(end)), \
-                scriptargs.stop_points():
+        with lifecycle.partial_outputs_on_failure(lambda *end: written.append(end)), \
+                lifecycle.stop_points():
             for step in range(5):
                 if step == 2:                                # the scheduler's wall-time limit
                     os.kill(os.getpid(), signal.SIGTERM)
                 steps.append(step)                           # the step in hand is finished
-                scriptargs.stop_point(lambda: saved.append(step))
+                lifecycle.stop_point(lambda: saved.append(step))
     with pytest.raises(SystemExit) as ended:
         _run_script(main, argparse.Namespace(out=str(tmp_path)))
     assert ended.value.code == 143
@@ -254,7 +245,7 @@ def test_a_signal_ends_the_run_as_interrupted_with_its_outputs(tmp_path, capsys)
     said = capsys.readouterr()
     assert said.err == "" and said.out.splitlines()[-1].startswith(
         "[yadebreak] interrupted (SIGTERM): ")       # (before it: YADE's greeting, if imported)
-    assert signal.getsignal(signal.SIGTERM) is not scriptargs._on_signal     # restored
+    assert signal.getsignal(signal.SIGTERM) is not lifecycle._on_signal     # restored
 
 
 def test_a_second_signal_stops_at_once(tmp_path):
@@ -263,7 +254,7 @@ def test_a_second_signal_stops_at_once(tmp_path):
     reached = []
 
     def main(args):
-        with scriptargs.stop_points():
+        with lifecycle.stop_points():
             os.kill(os.getpid(), signal.SIGINT)         # asks: the loop would stop at its point
             reached.append("after the first")
             os.kill(os.getpid(), signal.SIGINT)         # insists: stops here
@@ -288,11 +279,11 @@ def test_ctrl_c_inside_a_pyrunner_ends_as_interrupted_not_as_a_pyrunner_error(sc
     written = []
 
     def main(args):
-        with scriptargs.partial_outputs_on_failure(lambda *end: written.append(end)), \
-                scriptargs.stop_points():
+        with lifecycle.partial_outputs_on_failure(lambda *end: written.append(end)), \
+                lifecycle.stop_points():
             for _ in range(3):
                 coupling.run_steps(1)
-                scriptargs.stop_point()
+                lifecycle.stop_point()
     with pytest.raises(SystemExit) as ended:
         _run_script(main, argparse.Namespace(out=str(tmp_path)))
     said = capsys.readouterr()
@@ -307,13 +298,13 @@ def test_a_signal_wrapped_in_an_error_is_still_an_interruption(tmp_path):
     RuntimeError: the run still ends as interrupted."""
     import signal
     written = []
-    scriptargs._STOP["signal"] = signal.SIGINT
+    lifecycle._STOP["signal"] = signal.SIGINT
     try:
         with pytest.raises(RuntimeError):
-            with scriptargs.partial_outputs_on_failure(lambda *end: written.append(end)):
+            with lifecycle.partial_outputs_on_failure(lambda *end: written.append(end)):
                 raise RuntimeError("PyRunner error.\nCOMMAND: ...\nKeyboardInterrupt")
     finally:
-        scriptargs._STOP["signal"] = None
+        lifecycle._STOP["signal"] = None
     assert written == [("interrupted", "stopped by Ctrl-C, SIGINT")]
 
 
@@ -326,7 +317,7 @@ def _partial_results(tmp_path, **changes):
     result = {"specific_energy": 100.0, "particles": 10, "broken_fraction": 0.3,
               "model_probability": float(mat.breakage_probability(100.0, 5.5e-3, partner=steel)),
               "t10_simulated": 4.0, **changes}
-    scriptargs.PartialResults(tmp_path, args).add(100.0, result)
+    lifecycle.PartialResults(tmp_path, args).add(100.0, result)
     args.resume = True
 
     def validate(key, result):
@@ -346,8 +337,8 @@ def test_a_damaged_partial_file_is_refused_in_one_line(tmp_path, damage, why):
     args, validate = _partial_results(tmp_path)
     path = tmp_path / "partial.json"
     path.write_bytes(damage(path.read_bytes()))
-    with pytest.raises(scriptargs.ScriptError) as refused:
-        scriptargs.PartialResults(tmp_path, args, validate)
+    with pytest.raises(lifecycle.ScriptError) as refused:
+        lifecycle.PartialResults(tmp_path, args, validate)
     assert str(refused.value).startswith(f"--resume: {path} ") and why in str(refused.value)
     assert "\n" not in str(refused.value)
 
@@ -362,17 +353,17 @@ def test_a_result_this_run_could_not_have_written_is_refused(tmp_path, changes, 
     """With its digest made to match (the edit is not seen by it), the values themselves are
     checked against the run's arguments and the model."""
     args, validate = _partial_results(tmp_path, **changes)
-    assert scriptargs.PartialResults(tmp_path, args).done    # no check without validate
-    with pytest.raises(scriptargs.ScriptError, match="is not one this run could have written"):
-        scriptargs.PartialResults(tmp_path, args, validate)
-    with pytest.raises(scriptargs.ScriptError) as refused:
-        scriptargs.PartialResults(tmp_path, args, validate)
+    assert lifecycle.PartialResults(tmp_path, args).done    # no check without validate
+    with pytest.raises(lifecycle.ScriptError, match="is not one this run could have written"):
+        lifecycle.PartialResults(tmp_path, args, validate)
+    with pytest.raises(lifecycle.ScriptError) as refused:
+        lifecycle.PartialResults(tmp_path, args, validate)
     assert why in str(refused.value)
 
 
 def test_a_sound_partial_file_resumes(tmp_path):
     args, validate = _partial_results(tmp_path)
-    assert scriptargs.PartialResults(tmp_path, args, validate).done["100.0"]["particles"] == 10
+    assert lifecycle.PartialResults(tmp_path, args, validate).done["100.0"]["particles"] == 10
 
 
 @pytest.mark.yade
@@ -532,7 +523,7 @@ def test_a_signalled_bed_run_ends_interrupted_with_a_checkpoint(scene, tmp_path,
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["end_reason"] == "interrupted" and summary["end_message"] == f"stopped by {name}"
     from yadebreak import coupling
-    _, state = scriptargs.read_checkpoint(tmp_path / "checkpoint.yade.gz",
+    _, state = lifecycle.read_checkpoint(tmp_path / "checkpoint.yade.gz",
                                           coupling.load_checkpoint)   # whole, where it stopped
     assert scene.time == pytest.approx(summary["simulated_time"], rel=1e-12)
     assert scene.iter == summary["steps"] and state["arguments"]["rings"] == 1

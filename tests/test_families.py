@@ -95,7 +95,7 @@ def test_disk_cache_round_trip(tmp_path, monkeypatch):
     families._table_cached.cache_clear()
     beta = load_material("granulite").beta_params
     first = families.family_table(beta, 1.3, 40.0, seed=2)
-    assert list(tmp_path.glob("families-*.npz"))
+    assert list((tmp_path / "families").glob("families-*.npz"))     # <cache>/families
     families._table_cached.cache_clear()
     second = families.family_table(beta, 1.3, 40.0, seed=2)
     for a, b in zip(first.sets, second.sets):

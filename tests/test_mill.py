@@ -77,7 +77,7 @@ def test_a_resumed_mill_goes_on_from_its_checkpoint_and_refuses_other_arguments(
     from yade import O
     from yadebreak import coupling
     from yadebreak.runs import mill
-    from yadebreak.tools.options import ScriptError
+    from yadebreak.tools.lifecycle import ScriptError
     _, whole = mill.run(_args(tmp_path / "whole", duration=0.04, checkpoint_every=0.0),
                         quiet=True)
     whole_events = [json.loads(x) for x in

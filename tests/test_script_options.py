@@ -1,13 +1,16 @@
-"""Script options (issue 16): every numeric option is checked before the run (one line naming the
-option, the value, the range and the unit; exit code 2; no traceback), units may be written
+"""Script options: every numeric option is checked before the run (one line naming the option,
+the value, the range and the unit; exit code 2; no traceback), units may be written
 (`--size 5.5mm`), --help shows units and defaults, and the bed's --resume refuses other arguments
-and says when the run had finished. The scripts run as users run them."""
+and says when the run had finished. The options are read in this process, as each script reads
+them (yadebreak.runs.job_options); one script run as users run it shows that the scripts wire
+them through."""
 import json
 import subprocess
 from pathlib import Path
 
 import pytest
 
+from yadebreak.runs import job_options
 from yadebreak.tools.options import ParamError, numbers, number, script_params
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -22,10 +25,24 @@ def _yade(script, *arguments):
 def _one_error_line(proc):
     """The single `[yadebreak] error:` line of a failed run (YADE's own banner lines aside)."""
     assert proc.returncode == 2, proc.stdout[-1500:] + proc.stderr[-1500:]
-    assert "Traceback" not in proc.stdout + proc.stderr
-    lines = [line for line in (proc.stdout + proc.stderr).splitlines() if "error" in line.lower()]
+    return _the_error_line(proc.stdout + proc.stderr)
+
+
+def _the_error_line(said):
+    assert "Traceback" not in said
+    lines = [line for line in said.splitlines() if "error" in line.lower()]
     assert len(lines) == 1 and lines[0].startswith("[yadebreak] error: "), lines
     return lines[0]
+
+
+def _read(script, *arguments):
+    """Read the script's options in this process from `arguments`: the exit code if reading
+    ended the program (capsys holds what it printed), else None."""
+    try:
+        job_options.read(script, f"{script}'s description", list(arguments))
+    except SystemExit as ended:
+        return ended.code
+    return None
 
 
 # (script, arguments, the error line's "option = value", the range, the unit)
@@ -53,14 +70,35 @@ BAD_VALUES = [
 ]
 
 
-@pytest.mark.yade
 @pytest.mark.parametrize("script, arguments, named, accepted, unit", BAD_VALUES)
-def test_bad_value_stops_before_the_run_with_one_line(tmp_path, script, arguments, named,
+def test_bad_value_stops_before_the_run_with_one_line(tmp_path, capsys, script, arguments, named,
                                                       accepted, unit):
     out = tmp_path / "out"
-    line = _one_error_line(_yade(script, *arguments, "--out", str(out)))
+    assert _read(script, *arguments, "--out", str(out)) == 2
+    said = capsys.readouterr()
+    line = _the_error_line(said.out + said.err)
     assert f"{named}: must be {accepted}" in line and unit in line, line
     assert not out.exists()                          # stopped before anything was built
+
+
+@pytest.mark.parametrize("script", sorted(job_options.JOBS))
+def test_each_script_reads_its_own_options_and_runs_its_job(script):
+    """Each script is its options (job_options.read of its own name) and one call."""
+    text = (ROOT / "scripts" / f"{script}.py").read_text()
+    assert f'job_options.read("{script}", __doc__)' in text
+    assert len(text.splitlines()) <= 60
+    assert _read(script) is None                     # the defaults are accepted
+
+
+@pytest.mark.yade
+def test_a_script_wires_its_options_through(tmp_path):
+    """As users run it: a bad value and a cross-check of the bed stop YADE with the one line."""
+    out = tmp_path / "out"
+    line = _one_error_line(_yade("bed_impact", "--energy", "-1", "--out", str(out)))
+    assert line == "[yadebreak] error: --energy = -1: must be > 0 (J)"
+    line = _one_error_line(_yade("bed_impact", "--packing", "poured", "--out", str(out)))
+    assert "--packing = poured: must be with --layers >= 2 (got 1)" in line
+    assert not out.exists()
 
 
 def test_families_command_checks_t10(tmp_path):
@@ -109,7 +147,6 @@ def test_yade_batch_values_are_checked_the_same_way():
             ENERGY.convert(bad)
 
 
-@pytest.mark.yade
 @pytest.mark.parametrize("script, shown", [
     ("bed_impact", ["--size SIZE", "(m), a unit may follow the number: m, cm, mm, um",
                     "default 0.0055 m", "> 0 (J)", "default 3.05 J", "default 3 "]),
@@ -117,36 +154,56 @@ def test_yade_batch_values_are_checked_the_same_way():
     ("drop_weight", ["default 0.003 s", "default 150,600 J/kg"]),
     ("repeated_impact", ["> 0 (J/kg)", "default 94.7 J/kg", "default 0.0375 m"]),
 ])
-def test_help_shows_units_and_defaults(script, shown):
-    proc = _yade(script, "--help")
-    assert proc.returncode == 0, proc.stderr[-1500:]
-    text = " ".join(proc.stdout.split())          # argparse wraps lines
+def test_help_shows_units_and_defaults(capsys, script, shown):
+    assert _read(script, "--help") == 0
+    text = " ".join(capsys.readouterr().out.split())          # argparse wraps lines
     for s in shown:
         assert s in text, s
 
 
-def _bed(out, *extra):
-    return _yade("bed_impact", "--rings", "1", "--energy", "0.5", "--out", str(out), *extra)
-
-
 @pytest.mark.yade
-def test_bed_resume_refuses_other_arguments_and_says_when_finished(tmp_path):
-    cut = _bed(tmp_path, "--checkpoint-every", "0", "--stop-after", "1e-4")   # dies at 0.1 ms
-    assert cut.returncode == 0, cut.stderr[-1500:]
+def test_bed_resume_refuses_other_arguments_and_says_when_finished(scene, tmp_path, capsys):
+    """The bed's options read as its script reads them, run as its script runs them
+    (run_script), in this process."""
+    from yadebreak import coupling
+    from yadebreak.runs import bed
+    from yadebreak.tools.lifecycle import run_script
+
+    def _bed(out, *extra):
+        """(exit code, what the run printed)."""
+        coupling.forget()
+        scene.reset()
+        args = job_options.read("bed_impact", None, ["--rings", "1", "--energy", "0.5", "--out",
+                                                     str(out), *extra])
+        try:
+            run_script(bed.run, args)
+            code = 0
+        except SystemExit as ended:
+            code = ended.code
+        said = capsys.readouterr()
+        return code, said.out + said.err
+
+    def _refused(out, *extra):
+        code, said = _bed(out, *extra)
+        assert code == 2, said[-1500:]
+        return _the_error_line(said)
+
+    code, said = _bed(tmp_path, "--checkpoint-every", "0", "--stop-after", "1e-4")   # 0.1 ms
+    assert code == 0, said[-1500:]
     assert (tmp_path / "checkpoint.yade.gz").exists() and not (tmp_path / "summary.json").exists()
 
-    line = _one_error_line(_bed(tmp_path, "--resume", "1", "--energy", "0.6"))
+    line = _refused(tmp_path, "--resume", "1", "--energy", "0.6")
     assert "other values of ['energy']" in line, line
 
-    resumed = _bed(tmp_path, "--resume", "1", "--size", "5.5mm")      # the same arguments
-    assert resumed.returncode == 0, resumed.stderr[-1500:]
-    assert "resumed from" in resumed.stdout
+    code, said = _bed(tmp_path, "--resume", "1", "--size", "5.5mm")      # the same arguments
+    assert code == 0, said[-1500:]
+    assert "resumed from" in said
     summary = (tmp_path / "summary.json").read_text()
     assert not (tmp_path / "checkpoint.yade.gz").exists()             # finished: no checkpoint
 
-    again = _bed(tmp_path, "--resume", "1")
-    assert again.returncode == 0 and "had finished: nothing to resume" in again.stdout
+    code, said = _bed(tmp_path, "--resume", "1")
+    assert code == 0 and "had finished: nothing to resume" in said
     assert (tmp_path / "summary.json").read_text() == summary         # not rewritten
-    line = _one_error_line(_bed(tmp_path, "--resume", "1", "--energy", "0.6", "--rings", "2"))
+    line = _refused(tmp_path, "--resume", "1", "--energy", "0.6", "--rings", "2")
     assert "other values of ['energy', 'rings']" in line, line
     assert json.loads(summary)["energy"] == 0.5

@@ -32,8 +32,8 @@ import numpy as np
 from yadebreak.model import bonds, placement
 from yadebreak.model.intervals import Interval
 from yadebreak.coupling import engine
-from yadebreak.coupling.yade_api import O, utils, wrapper as _w
-from yadebreak.coupling.config import AttachError
+from .yade_api import O, utils, wrapper as _w
+from .config import AttachError
 
 #: stresses at or above this fraction of a bond's strength are counted (the document's Fig. 18)
 WATCH_LEVEL = 0.8

@@ -5,12 +5,12 @@ import json
 import os
 from pathlib import Path
 
-from yadebreak.coupling.yade_api import O, find_engine, wrapper
-from yadebreak.coupling.config import AttachError, Config
-from yadebreak.coupling.controller import Controller
-from yadebreak.coupling.scene_materials import breakable_spheres, resolve
-from yadebreak.coupling.state import BREAKABLE, BodyRow, EngineState
-from yadebreak.coupling.stepping import smallest_rayleigh_time
+from .yade_api import O, find_engine, wrapper
+from .config import AttachError, Config
+from .controller import Controller
+from .scene_materials import breakable_spheres, resolve
+from .state import BREAKABLE, BodyRow, EngineState
+from .stepping import smallest_rayleigh_time
 
 _ENGINES: dict[str, Controller] = {}
 _TAG = "yadebreak:"

@@ -11,8 +11,8 @@ import numpy as np
 
 from yadebreak import model
 from yadebreak.model import placement
-from yadebreak.coupling.yade_api import O, utils, wrapper
-from yadebreak.coupling.state import BREAKABLE, DUMMY, UNBREAKABLE
+from .yade_api import O, utils, wrapper
+from .state import BREAKABLE, DUMMY, UNBREAKABLE
 
 
 @dataclass

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import json
 
-from yadebreak.coupling.yade_api import O, utils, wrapper
+from .yade_api import O, utils, wrapper
 
 #: kr = STIFFNESS I_min / dt^2: stable (rotation frequency sqrt(2 kr / I_min) well below 2 / dt),
 #: and the cap mu_r F_n R is reached within a few steps of rolling

@@ -8,9 +8,9 @@ import math
 from yadebreak import model
 from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS
 from yadebreak.model.materials import Material, MaterialError, load_material
-from yadebreak.coupling.yade_api import O, wrapper
-from yadebreak.coupling.config import AttachError
-from yadebreak.coupling.criteria import criterion_for
+from .yade_api import O, wrapper
+from .config import AttachError
+from .criteria import criterion_for
 
 
 def _frict_material(mat: Material, label: str, stiffness_scale: float = 1.0):

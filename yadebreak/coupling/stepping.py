@@ -6,7 +6,7 @@ import heapq
 import math
 
 from yadebreak.model import placement
-from yadebreak.coupling.yade_api import O, find_engine, utils, wrapper
+from .yade_api import O, find_engine, utils, wrapper
 
 #: read_period="fast" never waits longer than this many steps between reads.
 FAST_MAX_PERIOD = 200

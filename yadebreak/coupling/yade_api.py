@@ -1,6 +1,6 @@
 """The one module of yadebreak that imports yade (from Debian's python3 too: see
 yadebreak.coupling.yadepath). The coupling, scenes and runs take YADE's names from here."""
-from yadebreak.coupling.yadepath import ensure_yade_importable
+from .yadepath import ensure_yade_importable
 
 ensure_yade_importable()
 

@@ -16,7 +16,7 @@ than with a visit every step (tolerance 0), and never harder.
 """
 from __future__ import annotations
 
-from yadebreak.coupling.yade_api import O, Vector3, find_engine, utils, wrapper
+from .yade_api import O, Vector3, find_engine, utils, wrapper
 
 #: a slack pair sleeps at most this many steps
 MAX_SLEEP = 50

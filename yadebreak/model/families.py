@@ -35,6 +35,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from yadebreak import model
+from .cache import cache_folder
 
 #: Class sizes x_k = 2^(-k/4), k = 0..9, then the dummy class at x_9 (Table 2).
 CLASS_SIZES = 2.0 ** (-np.arange(10) / 4.0)
@@ -291,12 +292,6 @@ class FamilyTable:
         return fams[min(i, len(fams) - 1)]
 
 
-def _cache_dir():
-    base = os.environ.get("YADEBREAK_CACHE") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "yadebreak")
-    return Path(base)
-
-
 def _cache_key(beta_key, t10_min, t10_max, seed):
     """Names a table's file: everything that decides its content."""
     text = json.dumps([_FORMAT_VERSION, beta_key, t10_min, t10_max, seed, _POOL_SIZE, TABLE_RATIO])
@@ -310,7 +305,7 @@ def _beta_key(beta_params):
 @lru_cache(maxsize=64)
 def _table_cached(beta_key, t10_min, t10_max, seed):
     beta_params = dict(beta_key)
-    path = _cache_dir() / f"families-{_cache_key(beta_key, t10_min, t10_max, seed)}.npz"
+    path = cache_folder("families") / f"families-{_cache_key(beta_key, t10_min, t10_max, seed)}.npz"
     if path.exists():
         try:
             data = np.load(path)
@@ -338,7 +333,7 @@ def _table_cached(beta_key, t10_min, t10_max, seed):
 
 def family_table(beta_params, t10_min, t10_max, seed=0):
     """The FamilyTable for a material, built once per process and cached on disk
-    ($YADEBREAK_CACHE, else ~/.cache/yadebreak)."""
+    (<cache>/families: yadebreak.model.cache)."""
     return _table_cached(_beta_key(beta_params), float(t10_min), float(t10_max), int(seed))
 
 

@@ -19,7 +19,6 @@ import csv
 import json
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -30,9 +29,8 @@ from yadebreak.coupling.yade_api import O, utils
 from yadebreak.coupling import bonded
 from yadebreak.coupling.bonded import WATCH_LEVEL, agglomerate_scene
 from yadebreak.coupling.engine import run_steps
-from yadebreak.tools.options import (CHECKPOINT, check_not_finished, check_resume_arguments, mark_finished,
-                         mark_started, partial_outputs_on_failure, progress, read_checkpoint,
-                         resume_arguments, stop_point, stop_points, time_left)
+from yadebreak.runs import skeleton
+from yadebreak.tools.lifecycle import resume_arguments
 
 #: the document's agglomerate: 4,104 spheres in a 30 mm mould; --particles keeps its packing
 #: density (spheres' volume over the mould's)
@@ -82,130 +80,129 @@ def build(args):
     return material, bonds.pack_in_sphere(diameters, mould, rng)
 
 
-def _start(args, out, say, start):
-    """(material, packing, scene, loop state): built, or from the checkpoint (--resume 1). The
-    loop state: the time series so far and the wall time of earlier invocations."""
-    if getattr(args, "resume", False):
-        check_not_finished(out, args)       # a finished run: says so, nothing is run or rewritten
-        scene, data = read_checkpoint(out / CHECKPOINT, bonded.load_checkpoint)
-        check_resume_arguments(data["arguments"], args, out / CHECKPOINT)
-        loop = data["loop"]
-        packing = bonds.Packing(**{k: np.array(v) if isinstance(v, list) else v
-                                   for k, v in loop.pop("packing").items()})
-        scene.impact_seconds = loop["impact_s"]
-        say(f"resumed from {out / CHECKPOINT} at t = {loop['series'][-1]['time_ms']:.4f} ms "
-            f"after the touch, iteration {O.iter}, {scene.watch.broken_count()} bonds broken")
-        return material_of(args), packing, scene, loop
-    mark_started(out)
-    (out / CHECKPOINT).unlink(missing_ok=True)      # an earlier run's: --resume must not find it
-    material, packing = build(args)
-    O.reset()
-    scene = agglomerate_scene(material, packing, seed=args.seed, speed=args.speed,
-                              time_step_fraction=args.time_step_fraction,
-                              check_period=args.check_period, duration=args.duration)
-    bonds_initial = len(scene.watch.mode)
-    say(f"{args.particles} spheres in a {2e3 * packing.mould_radius:.1f} mm mould, "
-        f"{bonds_initial} bonds ({2 * bonds_initial / args.particles:.2f} per sphere), dt "
-        f"{O.dt:.3g} s, built in {time.time() - start:.1f} s")
-    return material, packing, scene, {"series": [], "runtime_s": 0.0, "impact_s": 0.0,
-                                      "renew_at": 0}
+class Agglomerate(skeleton.Job):
+    """The agglomerate falls to its first touch, then is followed for --duration, sampled every
+    --sample-interval. Every RENEW_STEPS steps, at a sample, the contacts are renewed as a load
+    would (bonded.renew_contacts): only there may a checkpoint be written or SIGINT or SIGTERM
+    stop the run, so that a run resumed from it goes on exactly as this one."""
 
+    checkpoint_every = -1.0           # library use without --checkpoint-every: none
 
-def _checkpoint(out, scene, packing, loop, args, runtime_s):
-    """The scene with its BondWatch, the loop state and the run's arguments."""
-    state = {**loop, "runtime_s": runtime_s, "impact_s": scene.impact_seconds,
-             "packing": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
-                         for k, v in vars(packing).items()}}
-    bonded.save_checkpoint(out / CHECKPOINT, scene, {"loop": state,
-                                                     "arguments": resume_arguments(args)})
+    def __init__(self, args, quiet=False):
+        super().__init__(args, quiet)
+        self.started = time.time()    # this invocation's start (the last line's wall time)
+
+    def build(self):
+        args, began = self.args, time.time()
+        self.material, self.packing = build(args)
+        O.reset()
+        self.scene = agglomerate_scene(self.material, self.packing, seed=args.seed,
+                                       speed=args.speed,
+                                       time_step_fraction=args.time_step_fraction,
+                                       check_period=args.check_period, duration=args.duration)
+        bonds_initial = len(self.scene.watch.mode)
+        self.say(f"{args.particles} spheres in a {2e3 * self.packing.mould_radius:.1f} mm mould, "
+                 f"{bonds_initial} bonds ({2 * bonds_initial / args.particles:.2f} per sphere), "
+                 f"dt {O.dt:.3g} s, built in {time.time() - began:.1f} s")
+        self.loop = {"series": [], "runtime_s": 0.0, "impact_s": 0.0, "renew_at": 0}
+
+    def resume(self, path):
+        self.scene, data = skeleton.load_checked(path, bonded.load_checkpoint, self.args)
+        self.loop = data["loop"]
+        self.packing = bonds.Packing(**{k: np.array(v) if isinstance(v, list) else v
+                                        for k, v in self.loop.pop("packing").items()})
+        self.scene.impact_seconds = self.loop["impact_s"]
+        self.material = material_of(self.args)
+        self.say(f"resumed from {path} at t = {self.loop['series'][-1]['time_ms']:.4f} ms "
+                 f"after the touch, iteration {O.iter}, {self.scene.watch.broken_count()} bonds "
+                 "broken")
+        return self.loop["runtime_s"]
+
+    def open(self):
+        scene, packing = self.scene, self.packing
+        self.bonds_initial = len(scene.watch.mode)
+        self.log = FailureLog(self.out / "bonds_broken.csv", scene.watch, packing)
+        scene.watch.on_failure = self.log.write
+        self.frames = paraview.series(self.out / "paraview", None, self.args.vtk_interval,
+                                      resume=getattr(self.args, "resume", False),
+                                      wall_patch=((0.0, 0.0, 0.0),
+                                                  paraview.WALL_MARGIN * packing.mould_radius),
+                                      sphere_arrays=lambda ids: _paraview_arrays(ids, scene))
+        self.began = None             # wall time of the first advance (after the touch)
+
+    def advance(self):
+        args, scene, packing, loop = self.args, self.scene, self.packing, self.loop
+        watch, series = scene.watch, loop["series"]
+        if self.began is None:
+            self.chunk = max(1, int(round(args.sample_interval / O.dt)))
+            if watch.touch_time is None:      # to the first touch: the impact's t = 0
+                while watch.touch_time is None:
+                    run_steps(1)
+                    if O.time > 1.0:
+                        raise RuntimeError("the agglomerate never reached the plane in 1 s")
+                series.append(_sample(scene, packing))
+            self.began, self.impact_before = time.time(), scene.impact_seconds
+        self.renewed = False
+        if not O.time - watch.touch_time < args.duration - 0.5 * O.dt:
+            return "finished"
+        left = int(math.ceil((args.duration - (O.time - watch.touch_time)) / O.dt - 1e-9))
+        run_steps(min(self.chunk, max(left, 1)))
+        series.append(_sample(scene, packing))
+        self.frames()
+        scene.impact_seconds = self.impact_before + time.time() - self.began
+        if O.iter >= loop["renew_at"]:
+            bonded.renew_contacts()
+            loop["renew_at"] = O.iter + RENEW_STEPS
+            self.renewed = True
+        return None
+
+    def at_safe_point(self):
+        return self.renewed
+
+    def elapsed(self):
+        return O.time
+
+    def status(self):
+        row = self.loop["series"][-1]
+        return (f"t = {row['time_ms']:.3f} ms of {self.args.duration * 1e3:g}: damage ratio "
+                f"{row['damage_ratio']:.3f}, broken {row['broken_tension']} tension / "
+                f"{row['broken_shear']} shear / {row['broken_compression']} compression")
+
+    def done(self):
+        return self.loop["series"][-1]["time_ms"] * 1e-3 / self.args.duration
+
+    def save(self, path, wall_s):
+        """The scene with its BondWatch, the loop state and the run's arguments."""
+        state = {**self.loop, "runtime_s": wall_s, "impact_s": self.scene.impact_seconds,
+                 "packing": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                             for k, v in vars(self.packing).items()}}
+        bonded.save_checkpoint(path, self.scene, {"loop": state,
+                                                  "arguments": resume_arguments(self.args)})
+
+    def close(self):
+        self.frames.close()
+
+    def stopped(self):
+        self.log.close()
+
+    def outputs(self, end_reason, end_message, runtime_s):
+        self.log.close()
+        return _outputs(self.args, self.out, self.material, self.packing, self.scene,
+                        self.loop["series"], runtime_s, end_reason, end_message)
+
+    def finished(self, summary):
+        watch = self.scene.watch
+        self.say(f"{watch.broken_count()} of {self.bonds_initial} bonds broken (tension "
+                 f"{watch.broken_count(bonds.TENSION)}, shear {watch.broken_count(bonds.SHEAR)}, "
+                 f"compression {watch.broken_count(bonds.COMPRESSION)}), mean damage ratio "
+                 f"{summary['damage_ratio']:.3f}; wrote {self.out}/summary.json in "
+                 f"{time.time() - self.started:.0f} s")
 
 
 def run(args, quiet=False):
     """The whole run: build (or resume), impact, outputs. Returns the summary (a dict), None if
     it stopped early on purpose (--stop-after, tests)."""
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    say = (lambda message: None) if quiet else progress
-    start = time.time()
-    material, packing, scene, loop = _start(args, out, say, start)
-    watch = scene.watch
-    bonds_initial = len(watch.mode)
-    log = FailureLog(out / "bonds_broken.csv", watch, packing)
-    watch.on_failure = log.write
-    series = loop["series"]
-    frames = paraview.series(out / "paraview", None, args.vtk_interval,
-                             resume=getattr(args, "resume", False),
-                             wall_patch=((0.0, 0.0, 0.0),
-                                         paraview.WALL_MARGIN * packing.mould_radius),
-                             sphere_arrays=lambda ids: _paraview_arrays(ids, scene))
-
-    def runtime_s():                      # over every invocation, up to its last checkpoint
-        return loop["runtime_s"] + time.time() - start
-
-    def write(end_reason, end_message):
-        log.close()
-        return _outputs(args, out, material, packing, scene, series, runtime_s(), end_reason,
-                        end_message)
-
-    with partial_outputs_on_failure(write), stop_points():
-        ended = _impact(args, out, scene, packing, loop, frames, say, start, runtime_s)
-        if ended is None:
-            log.close()
-            return None
-        frames.close()
-    summary = write("finished", "")
-    mark_finished(out, args)                      # --resume 1 now says so and does nothing
-    (out / CHECKPOINT).unlink(missing_ok=True)    # a mid-run state, of no more use
-    say(f"{watch.broken_count()} of {bonds_initial} bonds broken (tension "
-        f"{watch.broken_count(bonds.TENSION)}, shear {watch.broken_count(bonds.SHEAR)}, "
-        f"compression {watch.broken_count(bonds.COMPRESSION)}), mean damage ratio "
-        f"{summary['damage_ratio']:.3f}; wrote {out}/summary.json in {time.time() - start:.0f} s")
-    return summary
-
-
-def _impact(args, out, scene, packing, loop, frames, say, start, runtime_s):
-    """Step to the first touch, then for --duration, sampling every --sample-interval, with
-    checkpoints every --checkpoint-every s of wall time. "finished", or None if it stopped at
-    --stop-after (s of simulated time; tests: as if killed there). Every RENEW_STEPS steps, at a
-    sample, the contacts are renewed as a load would (bonded.renew_contacts): there a checkpoint
-    is written if one is due, or if SIGINT or SIGTERM came (within stop_points), and a run
-    resumed from it goes on exactly as this one."""
-    watch, series = scene.watch, loop["series"]
-    chunk = max(1, int(round(args.sample_interval / O.dt)))
-    every = getattr(args, "checkpoint_every", -1.0)
-    stop_after = getattr(args, "stop_after", 0.0)
-    if watch.touch_time is None:
-        while watch.touch_time is None:
-            run_steps(1)
-            if O.time > 1.0:
-                raise RuntimeError("the agglomerate never reached the plane in 1 s")
-        series.append(_sample(scene, packing))
-    said = began = last_checkpoint = time.time()
-    impact_before = scene.impact_seconds
-    while O.time - watch.touch_time < args.duration - 0.5 * O.dt:
-        left = int(math.ceil((args.duration - (O.time - watch.touch_time)) / O.dt - 1e-9))
-        run_steps(min(chunk, max(left, 1)))
-        series.append(_sample(scene, packing))
-        frames()
-        scene.impact_seconds = impact_before + time.time() - began
-        if O.iter >= loop["renew_at"]:
-            bonded.renew_contacts()
-            loop["renew_at"] = O.iter + RENEW_STEPS
-            if every >= 0 and time.time() - last_checkpoint >= every:
-                _checkpoint(out, scene, packing, loop, args, runtime_s())   # --resume goes on here
-                last_checkpoint = time.time()
-            stop_point(lambda: _checkpoint(out, scene, packing, loop, args, runtime_s()))
-        if stop_after and O.time >= stop_after:
-            return None                           # (tests) as if the run had died here
-        if time.time() - said > 10.0:
-            said = time.time()
-            row = series[-1]
-            done = row["time_ms"] * 1e-3 / args.duration
-            say(f"t = {row['time_ms']:.3f} ms of {args.duration * 1e3:g}: damage ratio "
-                f"{row['damage_ratio']:.3f}, broken {row['broken_tension']} tension / "
-                f"{row['broken_shear']} shear / {row['broken_compression']} compression, "
-                f"{time.time() - start:.0f} s, {time_left(time.time() - began, done)}")
-    return "finished"
+    return skeleton.run(Agglomerate(args, quiet))
 
 
 def _sample(scene, packing):

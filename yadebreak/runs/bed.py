@@ -4,8 +4,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import time
-from pathlib import Path
 
 import numpy as np
 
@@ -13,10 +11,9 @@ from yadebreak import coupling, scenes
 from yadebreak.runs import paraview
 from yadebreak.scenes import poured_bed
 from yadebreak.coupling.yade_api import O
-from yadebreak.tools.options import (check_not_finished, check_resume_arguments, mark_finished, mark_started,
-                         partial_outputs_on_failure, progress, read_checkpoint, read_period_value,
-                         resume_arguments, run_wall_time, stop_point, stop_points, time_left,
-                         write_atomic)
+from yadebreak.runs import skeleton
+from yadebreak.tools.lifecycle import resume_arguments, write_atomic
+from yadebreak.tools.options import read_period_value
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
 TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
@@ -43,26 +40,6 @@ def capture_radius(brk, info):
     return max(radii) if radii else 0.0
 
 
-def _checkpoint(path, info, loop, args, start):
-    """The scene, the loop's own state (with the run's wall time so far, from the invocation's
-    `start`) and the run's arguments (coupling.save_checkpoint)."""
-    loop["wall_s"] = run_wall_time(loop, start)
-    coupling.save_checkpoint(path, {
-        "loop": loop, "info": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
-                               for k, v in info.items() if k != "material"},
-        "arguments": resume_arguments(args)})
-
-
-def _resume(path, args):
-    """The checkpoint's scene, refused (naming them) if it was run with other arguments."""
-    brk, data = read_checkpoint(path, coupling.load_checkpoint)
-    if "arguments" in data:                 # (checkpoints written before they were recorded: not)
-        check_resume_arguments(data["arguments"], args, path)
-    info = data["info"]
-    info["centers"] = np.array(info["centers"])
-    return brk, info, data["loop"]
-
-
 def _options(args, out):
     """attach() options from the script's arguments."""
     read_period = read_period_value(args.read_period)
@@ -75,30 +52,6 @@ def _options(args, out):
     if getattr(args, "stiffness_scale", 1.0) != 1.0:
         options["stiffness_scale"] = args.stiffness_scale
     return options
-
-
-def _start(args, out, energy, say):
-    """The scene, new or from the checkpoint (--resume 1): (controller, info, loop state)."""
-    checkpoint = out / "checkpoint.yade.gz"
-    if getattr(args, "resume", False):
-        check_not_finished(out, args)       # a finished run: says so, nothing is run or rewritten
-        brk, info, loop = _resume(checkpoint, args)
-        loop["wall_before_s"] = loop.get("wall_s", 0.0)   # the run's wall time: all invocations
-        say(f"resumed from {checkpoint} at t = {1e3 * O.time:.3f} ms, iteration {O.iter}")
-        return brk, info, loop
-    mark_started(out)
-    steel_rolling = getattr(args, "steel_rolling_friction", -1.0)
-    brk, info = scenes.bed_impact_scene(
-        args.material, args.size, args.rings, args.layers, energy, args.seed,
-        packing=None if getattr(args, "packing", "auto") == "auto" else args.packing,
-        rolling=bool(getattr(args, "rolling_friction", True)),
-        steel_rolling_friction=None if steel_rolling < 0 else steel_rolling,
-        bed_cache=_bed_cache(getattr(args, "bed_cache", "")), say=say, **_options(args, out))
-    mass = brk.total_mass()
-    say(f"{len(info['particles'])} particles of {args.material} ({1e3 * args.size:g} mm), "
-        f"{args.layers} layer(s); ball at {info['speed']:.3f} m/s ({energy:g} J, "
-        f"{energy / mass:.0f} J per kg of bed); dt {O.dt:.3g} s")
-    return brk, info, {"touched": None, "turned": None, "initial_mass": mass, "initial_dt": O.dt}
 
 
 def _bed_cache(given):
@@ -135,16 +88,46 @@ def _paraview(args, out, brk, info):
                            wall_patch=((0.0, 0.0, 0.0), paraview.WALL_MARGIN * reach))
 
 
-def _impact(brk, info, loop, args, out, start, say, frames):
-    """Run until the ball has turned plus TAIL of unloading (or max_time), with progress lines,
-    ParaView frames and checkpoints. Returns how it ended: "finished", "time_limit" (max_time),
-    or None if it stopped early on purpose (--stop-after, tests)."""
-    ball = O.bodies[info["ball"]]
-    v0 = info["speed"]
-    every = getattr(args, "checkpoint_every", 60.0)
-    stop_after = getattr(args, "stop_after", 0.0)
-    last_report = last_checkpoint = start
-    while True:
+class BedImpact(skeleton.Job):
+    """The ball falls on the bed until it has turned plus TAIL of unloading (or --max-time)."""
+
+    report_every = 5.0
+
+    def __init__(self, args, quiet=False):
+        super().__init__(args, quiet)
+        self.energy = args.energy if args.speed <= 0 else 0.5 * scenes.BALL_MASS * args.speed ** 2
+
+    def build(self):
+        args, energy = self.args, self.energy
+        steel_rolling = getattr(args, "steel_rolling_friction", -1.0)
+        self.brk, self.info = scenes.bed_impact_scene(
+            args.material, args.size, args.rings, args.layers, energy, args.seed,
+            packing=None if getattr(args, "packing", "auto") == "auto" else args.packing,
+            rolling=bool(getattr(args, "rolling_friction", True)),
+            steel_rolling_friction=None if steel_rolling < 0 else steel_rolling,
+            bed_cache=_bed_cache(getattr(args, "bed_cache", "")), say=self.say,
+            **_options(args, self.out))
+        mass = self.brk.total_mass()
+        self.say(f"{len(self.info['particles'])} particles of {args.material} "
+                 f"({1e3 * args.size:g} mm), {args.layers} layer(s); ball at "
+                 f"{self.info['speed']:.3f} m/s ({energy:g} J, {energy / mass:.0f} J per kg of "
+                 f"bed); dt {O.dt:.3g} s")
+        self.loop = {"touched": None, "turned": None, "initial_mass": mass, "initial_dt": O.dt}
+
+    def resume(self, path):
+        self.brk, data = skeleton.load_checked(path, coupling.load_checkpoint, self.args)
+        self.info, self.loop = data["info"], data["loop"]
+        self.info["centers"] = np.array(self.info["centers"])
+        self.loop["wall_before_s"] = self.loop.get("wall_s", 0.0)   # all invocations
+        self.say(f"resumed from {path} at t = {1e3 * O.time:.3f} ms, iteration {O.iter}")
+        return self.loop["wall_before_s"]
+
+    def open(self):
+        self.frames = _paraview(self.args, self.out, self.brk, self.info)
+        self.ball = O.bodies[self.info["ball"]]
+
+    def advance(self):
+        loop, info = self.loop, self.info
         if loop["touched"] is None:           # the bed's motion before the ball reaches it
             before_touch = poured_bed.kinetic_energy(info["particles"])
         coupling.run_steps(100 if loop["touched"] is None else 400)
@@ -152,70 +135,73 @@ def _impact(brk, info, loop, args, out, start, say, frames):
             loop["touched"] = O.time
             loop["bed_kinetic_energy_at_touch"] = before_touch
             scenes.hold_release(info)
-        frames()                                  # a frame if one is due (before the checkpoint)
-        vz = ball.state.vel[2]
+        self.frames()                             # a frame if one is due (before the checkpoint)
+        vz = self.ball.state.vel[2]
         if loop["touched"] is not None and loop["turned"] is None and vz >= 0.0:
             loop["turned"] = O.time            # deepest penetration: loading is over
-        touched, turned = loop["touched"], loop["turned"]
         # breakage happens while loading: after the turn, a short unloading, then open events
         # are closed with their largest energy (brk.finish)
-        if turned is not None and O.time >= turned + TAIL:
+        if loop["turned"] is not None and O.time >= loop["turned"] + TAIL:
             return "finished"
-        if O.time > args.max_time:
-            say(f"stopped at max_time = {args.max_time} s of simulated time")
+        if O.time > self.args.max_time:
+            self.say(f"stopped at max_time = {self.args.max_time} s of simulated time")
             return "time_limit"
-        now = time.time()
-        if every >= 0 and now - last_checkpoint >= every:
-            _checkpoint(out / "checkpoint.yade.gz", info, loop, args, start)  # --resume 1 goes on
-            last_checkpoint = now
-        # SIGINT, SIGTERM (run() catches them in stop_points): end here, checkpointed
-        stop_point(lambda: _checkpoint(out / "checkpoint.yade.gz", info, loop, args, start))
-        if stop_after and O.time >= stop_after:
-            return None                           # (tests) as if the run had died here
-        if now - last_report > 5.0:
-            done = 0.0 if touched is None else (0.5 * (1 - max(-vz, 0.0) / v0) if turned is None
-                                                else 0.5 + 0.5 * (O.time - turned) / TAIL)
-            say(f"t = {1e3 * O.time:.3f} ms, {len(brk.breakage_events)} breakages, "
-                f"{sum(1 for b in O.bodies if b is not None)} bodies, ball {vz:+.3f} m/s, "
-                f"wall {now - start:.0f} s, {time_left(now - start, done)}")
-            last_report = now
+        return None
+
+    def elapsed(self):
+        return O.time
+
+    def status(self):
+        vz = self.ball.state.vel[2]
+        return (f"t = {1e3 * O.time:.3f} ms, {len(self.brk.breakage_events)} breakages, "
+                f"{sum(1 for b in O.bodies if b is not None)} bodies, ball {vz:+.3f} m/s")
+
+    def done(self):
+        touched, turned = self.loop["touched"], self.loop["turned"]
+        if touched is None:
+            return 0.0
+        if turned is None:
+            return 0.5 * (1 - max(-self.ball.state.vel[2], 0.0) / self.info["speed"])
+        return 0.5 + 0.5 * (O.time - turned) / TAIL
+
+    def save(self, path, wall_s):
+        """The scene, the loop's own state (with the run's wall time so far) and the run's
+        arguments (coupling.save_checkpoint)."""
+        self.loop["wall_s"] = wall_s
+        coupling.save_checkpoint(path, {
+            "loop": self.loop,
+            "info": {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+                     for k, v in self.info.items() if k != "material"},
+            "arguments": resume_arguments(self.args)})
+
+    def close(self):
+        self.brk.finish()
+        self.frames.close()                       # the last frame, with the events closed
+
+    def end_message(self, ended):
+        return "" if ended == "finished" else f"stopped at --max-time {self.args.max_time} s"
+
+    def outputs(self, end_reason, end_message, runtime_s):
+        return _report(self.brk, self.info, self.loop, self.args, self.out, self.energy,
+                       runtime_s, end_reason, end_message)
+
+    def finished(self, summary):
+        self.say(f"done in {summary['runtime_s']:.1f} s: {summary['breakage_events']} "
+                 f"breakages, broken mass {1e3 * summary['broken_mass']:.3f} g "
+                 f"({100 * summary['broken_mass_fraction']:.1f} %), capture radius "
+                 f"{1e3 * summary['capture_radius']:.1f} mm; outputs in {self.out}")
+        why = why_it_took_longer(summary)
+        if why:
+            self.say(f"{summary['steps']} steps: {why}")
+
+    def result(self, summary):
+        return self.brk, summary
 
 
 def run(args, quiet=False):
-    """Build, run and report one bed impact. Returns (controller, summary dict)."""
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    energy = args.energy if args.speed <= 0 else 0.5 * scenes.BALL_MASS * args.speed ** 2
-    start = time.time()
-    say = (lambda m: None) if quiet else progress
-    # SIGINT, SIGTERM from here on: the run ends at its loop's next stop_point, checkpointed
-    with stop_points():
-        brk, info, loop = _start(args, out, energy, say)
-        frames = _paraview(args, out, brk, info)
-
-        def runtime():                                # s: the whole run's, over its invocations
-            return run_wall_time(loop, start)
-
-        def partial(end_reason, end_message):         # the outputs so far; the checkpoint is kept
-            _report(brk, info, loop, args, out, energy, runtime(), end_reason, end_message)
-
-        with partial_outputs_on_failure(partial):
-            ended = _impact(brk, info, loop, args, out, start, say, frames)
-    if ended is None:
-        return brk, None
-    brk.finish()
-    frames.close()                                # the last frame, with the events closed
-    summary = _report(brk, info, loop, args, out, energy, runtime(), ended,
-                      "" if ended == "finished" else f"stopped at --max-time {args.max_time} s")
-    mark_finished(out, args)                      # --resume 1 now says so and does nothing
-    (out / "checkpoint.yade.gz").unlink(missing_ok=True)    # a mid-run state, of no more use
-    say(f"done in {summary['runtime_s']:.1f} s: {summary['breakage_events']} breakages, broken "
-        f"mass {1e3 * summary['broken_mass']:.3f} g ({100 * summary['broken_mass_fraction']:.1f} "
-        f"%), capture radius {1e3 * summary['capture_radius']:.1f} mm; outputs in {out}")
-    why = why_it_took_longer(summary)
-    if why:
-        say(f"{summary['steps']} steps: {why}")
-    return brk, summary
+    """Build, run and report one bed impact. Returns (controller, summary dict); the summary is
+    None if the run stopped at --stop-after (tests)."""
+    return skeleton.run(BedImpact(args, quiet))
 
 
 def _report(brk, info, loop, args, out, energy, runtime, end_reason, end_message):

@@ -1,4 +1,4 @@
-"""The stability matrix (issue 7): scenes at the extremes of every input, and what each must satisfy.
+"""The stability matrix: scenes at the extremes of every input, and what each must satisfy.
 
 Each case builds a small scene, runs it to its end, and measures: no NaN or infinity in any body
 or event; total mass (spheres plus ledger) conserved to 1e-9; no fragment leaving faster than its
@@ -9,10 +9,13 @@ Coupling layer: imports yade through the scene builders.
 """
 from __future__ import annotations
 
+import csv
 import dataclasses
+import json
 import math
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -20,6 +23,7 @@ from yadebreak import coupling, scenes
 from yadebreak.coupling import add_materials, attach
 from yadebreak.coupling.yade_api import O, utils
 from yadebreak.model.materials import load_material
+from yadebreak.tools.lifecycle import progress
 
 SIZE = 5.5e-3
 
@@ -220,3 +224,51 @@ def run_case(case, fast=False):
     brk.close()
     return result
 
+
+def run(args):
+    """The matrix (args.only: the cases whose name holds it; args.fast: the test suite's particle
+    counts): a table on stdout, and extremes.md, extremes.csv and extremes.json in args.out.
+    Returns the exit status: 1 if any case fails. No checkpoints or --resume: a case takes
+    seconds and the matrix is run whole."""
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    start = time.time()
+    for case in cases():
+        if args.only and args.only not in case.name:
+            continue
+        r = run_case(case, fast=args.fast)
+        rows.append(r)
+        progress(f"{case.name}: {'ok' if r['ok'] else 'FAILED'}, {r['breakages']} breakages, "
+                 f"{r['steps']} steps, {r['wall_s']:.1f} s")
+    table = _table(rows)
+    print(table)
+    (out / "extremes.md").write_text(table + "\n")
+    with open(out / "extremes.csv", "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+        writer.writeheader()
+        for r in rows:
+            writer.writerow({k: (";".join(v) if isinstance(v, list) else v) for k, v in r.items()})
+    (out / "extremes.json").write_text(json.dumps(rows, indent=2))
+    failed = [r["case"] for r in rows if not r["ok"]]
+    progress(f"{len(rows) - len(failed)} of {len(rows)} cases ok in {time.time() - start:.0f} s; "
+             f"wrote {out / 'extremes.md'}" + (f"; FAILED: {failed}" if failed else ""))
+    return 1 if failed else 0
+
+
+def _table(rows):
+    """The results as a Markdown table, a row per case."""
+    lines = ["| case | particles | breakages | most in one step | steps | ended | finite | mass "
+             "error | fragment speed margin (m/s) | kinetic energy before, after (J) | warnings "
+             "| wall (s) | ok |", "|" + "---|" * 13]
+    for r in rows:
+        margin = ("-" if r["fragment_speed_excess"] == float("-inf")
+                  else f"{r['fragment_speed_excess']:.1e}")
+        lines.append(f"| {r['case']} | {r['particles']} | {r['breakages']} "
+                     f"| {r['max_breakages_one_step']} | {r['steps']} "
+                     f"| {'yes' if r['ended'] else 'NO'} | {'yes' if r['finite'] else 'NO'} "
+                     f"| {r['mass_error']:.1e} | {margin} "
+                     f"| {r['kinetic_before']:.3g}, {r['kinetic_after']:.3g} "
+                     f"| {', '.join(r['warnings']) or '-'} "
+                     f"| {r['wall_s']:.1f} | {'yes' if r['ok'] else 'NO'} |")
+    return "\n".join(lines)

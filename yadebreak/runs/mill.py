@@ -13,8 +13,6 @@ from __future__ import annotations
 import csv
 import json
 import math
-import time
-from pathlib import Path
 
 import numpy as np
 
@@ -23,10 +21,10 @@ from yadebreak.model import milling
 from yadebreak.runs import paraview
 from yadebreak.coupling.yade_api import O, utils, wrapper as _w
 from yadebreak.coupling.stepping import smallest_rayleigh_time
-from yadebreak.tools.options import (ScriptError, check_not_finished, check_resume_arguments, mark_finished,
-                         mark_started, partial_outputs_on_failure, progress, read_checkpoint,
-                         read_period_value, resume_arguments, run_wall_time, stop_point,
-                         stop_points, time_left, write_atomic)
+from yadebreak.runs import skeleton
+from .job_options import check_mill_geometry
+from yadebreak.tools.lifecycle import ScriptError, resume_arguments, write_atomic
+from yadebreak.tools.options import read_period_value
 
 PACKING = 0.6                    # solid fraction of a settled charge (bulk volume -> solid volume)
 SETTLE_TIME = 0.25               # s of settling under gravity, drum still, before the engine
@@ -108,17 +106,10 @@ def charge_counts(args):
 
 
 def check_geometry(args):
-    """Cross-checks of the options that one range cannot say (one line each)."""
-    radius = 0.5 * args.drum_diameter
-    if args.ball_size >= radius:
-        raise ScriptError(f"--ball-size = {args.ball_size:g}: must be < the drum's radius "
-                          f"{radius:g} (m)")
-    if args.lifter_height >= 0.5 * radius:
-        raise ScriptError(f"--lifter-height = {args.lifter_height:g}: must be < half the drum's "
-                          f"radius, {0.5 * radius:g} (m)")
-    if args.size >= args.ball_size * 2:
-        raise ScriptError(f"--size = {args.size:g}: must be < twice --ball-size, "
-                          f"{2 * args.ball_size:g} (m)")
+    """Cross-checks of the options that one range cannot say (ScriptError, one line each)."""
+    problem = check_mill_geometry(args)
+    if problem:
+        raise ScriptError(problem)
 
 
 # -- the scene ----------------------------------------------------------------------------------------
@@ -250,29 +241,6 @@ def _sample(brk, info, loop, args):
     loop["lever_arm"].append(arm)
 
 
-def _start(args, out, say):
-    checkpoint = out / "checkpoint.yade.gz"
-    if getattr(args, "resume", False):
-        check_not_finished(out, args)
-        brk, data = read_checkpoint(checkpoint, lambda path: _loaded(*coupling.load_checkpoint(
-            path)))
-        check_resume_arguments(data["arguments"], args, checkpoint)
-        say(f"resumed from {checkpoint} at t = {mill_time(data['info']):.3f} s")
-        data["loop"]["wall_before_s"] = data["loop"].get("wall_s", 0.0)   # earlier invocations
-        return brk, data["info"], data["loop"]
-    mark_started(out)
-    brk, info = mill_scene(args, _options(args, out))
-    loop = {"initial_mass": brk.total_mass(), "initial_dt": O.dt, "sieves":
-            sieves_for(args).tolist(), "times": [], "passing": [], "feed_mass": [],
-            "charge_mass": [], "lever_arm": [], "torque_time": [], "torque": [],
-            "next_sample": 0.0}
-    say(f"{len(info['balls'])} balls ({1e3 * args.ball_size:g} mm) and {len(info['ore'])} "
-        f"particles of {args.material} ({1e3 * args.size:g} mm) in a {1e3 * args.drum_diameter:g}"
-        f" x {1e3 * args.drum_length:g} mm drum at {60 * info['speed_rps']:.1f} rpm "
-        f"({100 * args.speed:g} % of critical); dt {O.dt:.3g} s")
-    return brk, info, loop
-
-
 def _loaded(brk, data):
     """A checkpoint's state, its parts checked (a damaged one fails here, before the run)."""
     for part in ("arguments", "info", "loop"):
@@ -281,76 +249,93 @@ def _loaded(brk, data):
     return brk, data
 
 
-def run(args, quiet=False):
-    """Build, run and report one mill. Returns (controller, summary dict)."""
-    check_geometry(args)                          # before anything is written
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    start = time.time()
-    say = (lambda m: None) if quiet else progress
-    # SIGINT, SIGTERM from here on: the run ends at its loop's next stop_point, checkpointed
-    with stop_points():
-        brk, info, loop = _start(args, out, say)
-        frames = paraview.series(out / "paraview", brk, args.vtk_interval,
-                                 resume=getattr(args, "resume", False))
+class Mill(skeleton.Job):
+    """The drum turns for --duration s of simulated time: samples, torque, ParaView frames."""
 
-        def runtime():                # s: the whole run's, over its invocations (to checkpoints)
-            return run_wall_time(loop, start)
+    BATCH = 200                       # steps between two readings of the torque
 
-        def partial(end_reason, end_message):
-            _report(brk, info, loop, args, out, runtime(), end_reason, end_message)
+    def check(self):
+        check_geometry(self.args)
 
-        with partial_outputs_on_failure(partial):
-            ended = _mill(brk, info, loop, args, out, start, say, frames)
-    if ended is None:
-        return brk, None
-    brk.finish()
-    frames.close()
-    summary = _report(brk, info, loop, args, out, runtime(), ended, "")
-    mark_finished(out, args)
-    (out / "checkpoint.yade.gz").unlink(missing_ok=True)
-    say(f"done in {summary['runtime_s']:.0f} s: {summary['breakage_events']} breakages, broken "
-        f"mass {100 * summary['broken_mass_fraction']:.2f} % of the ore, mean power "
-        f"{summary['mean_power_W']:.1f} W; outputs in {out}")
-    return brk, summary
+    def build(self):
+        args = self.args
+        self.brk, self.info = mill_scene(args, _options(args, self.out))
+        self.loop = {"initial_mass": self.brk.total_mass(), "initial_dt": O.dt,
+                     "sieves": sieves_for(args).tolist(), "times": [], "passing": [],
+                     "feed_mass": [], "charge_mass": [], "lever_arm": [], "torque_time": [],
+                     "torque": [], "next_sample": 0.0}
+        self.say(f"{len(self.info['balls'])} balls ({1e3 * args.ball_size:g} mm) and "
+                 f"{len(self.info['ore'])} particles of {args.material} ({1e3 * args.size:g} "
+                 f"mm) in a {1e3 * args.drum_diameter:g} x {1e3 * args.drum_length:g} mm drum at "
+                 f"{60 * self.info['speed_rps']:.1f} rpm ({100 * args.speed:g} % of critical); "
+                 f"dt {O.dt:.3g} s")
 
+    def resume(self, path):
+        self.brk, data = skeleton.load_checked(
+            path, lambda p: _loaded(*coupling.load_checkpoint(p)), self.args)
+        self.info, self.loop = data["info"], data["loop"]
+        self.say(f"resumed from {path} at t = {mill_time(self.info):.3f} s")
+        self.loop["wall_before_s"] = self.loop.get("wall_s", 0.0)   # earlier invocations
+        return self.loop["wall_before_s"]
 
-def _mill(brk, info, loop, args, out, start, say, frames):
-    """Turn the drum for args.duration s of simulated time: samples, torque, progress lines,
-    ParaView frames and checkpoints. "finished", or None if stopped on purpose (--stop-after)."""
-    last_report = last_checkpoint = start
-    batch = 200
-    while mill_time(info) < args.duration:
-        coupling.run_steps(batch)
+    def open(self):
+        self.frames = paraview.series(self.out / "paraview", self.brk, self.args.vtk_interval,
+                                      resume=getattr(self.args, "resume", False))
+
+    def advance(self):
+        args, info, loop = self.args, self.info, self.loop
+        if mill_time(info) >= args.duration:
+            _sample(self.brk, info, loop, args)
+            return "finished"
+        coupling.run_steps(self.BATCH)
         now_s = mill_time(info)
         loop["torque_time"].append(now_s)
         loop["torque"].append(drum_torque(info["drum"]))
         if now_s >= loop["next_sample"]:
-            _sample(brk, info, loop, args)
+            _sample(self.brk, info, loop, args)
             loop["next_sample"] = now_s + args.sample_interval
-        frames()
-        now = time.time()
-        if args.checkpoint_every >= 0 and now - last_checkpoint >= args.checkpoint_every:
-            _checkpoint(out, info, loop, args, start)
-            last_checkpoint = now
-        stop_point(lambda: _checkpoint(out, info, loop, args, start))    # SIGINT, SIGTERM
-        if args.stop_after and now_s >= args.stop_after:
-            return None
-        if now - last_report > 10.0:
-            say(f"t = {now_s:.3f} of {args.duration:g} s, {len(brk.breakage_events)} breakages, "
-                f"{sum(1 for b in O.bodies if b is not None)} bodies, dt {O.dt:.2g} s, wall "
-                f"{now - start:.0f} s, {time_left(now - start, now_s / args.duration)}")
-            last_report = now
-    _sample(brk, info, loop, args)
-    return "finished"
+        self.frames()
+        return None
+
+    def elapsed(self):
+        return mill_time(self.info)
+
+    def status(self):
+        return (f"t = {mill_time(self.info):.3f} of {self.args.duration:g} s, "
+                f"{len(self.brk.breakage_events)} breakages, "
+                f"{sum(1 for b in O.bodies if b is not None)} bodies, dt {O.dt:.2g} s")
+
+    def done(self):
+        return mill_time(self.info) / self.args.duration
+
+    def save(self, path, wall_s):
+        """The scene and the loop's state, with the run's wall time so far: --resume 1 goes on
+        from it."""
+        self.loop["wall_s"] = wall_s
+        coupling.save_checkpoint(path, {"loop": self.loop, "info": self.info,
+                                        "arguments": resume_arguments(self.args)})
+
+    def close(self):
+        self.brk.finish()
+        self.frames.close()
+
+    def outputs(self, end_reason, end_message, runtime_s):
+        return _report(self.brk, self.info, self.loop, self.args, self.out, runtime_s,
+                       end_reason, end_message)
+
+    def finished(self, summary):
+        self.say(f"done in {summary['runtime_s']:.0f} s: {summary['breakage_events']} "
+                 f"breakages, broken mass {100 * summary['broken_mass_fraction']:.2f} % of the "
+                 f"ore, mean power {summary['mean_power_W']:.1f} W; outputs in {self.out}")
+
+    def result(self, summary):
+        return getattr(self, "brk", None), summary
 
 
-def _checkpoint(out, info, loop, args, start):
-    """The scene and the loop's state, with the run's wall time so far (this invocation began
-    at `start`): --resume 1 goes on from it."""
-    loop["wall_s"] = run_wall_time(loop, start)
-    coupling.save_checkpoint(out / "checkpoint.yade.gz", {
-        "loop": loop, "info": info, "arguments": resume_arguments(args)})
+def run(args, quiet=False):
+    """Build, run and report one mill. Returns (controller, summary dict); the summary is None if
+    the run stopped at --stop-after (tests)."""
+    return skeleton.run(Mill(args, quiet))
 
 
 def _report(brk, info, loop, args, out, runtime, end_reason, end_message):

@@ -26,7 +26,7 @@ import numpy as np
 
 from yadebreak.coupling.yade_api import O, wrapper
 from yadebreak.coupling.state import NONE
-from yadebreak.tools.options import write_atomic
+from yadebreak.tools.lifecycle import write_atomic
 
 #: frames over a run's planned simulated time when no interval is given (bed.run: max_time / 20)
 DEFAULT_FRAMES = 20

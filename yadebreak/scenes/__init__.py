@@ -5,8 +5,7 @@ impacts     particles shot at a target, repeated impacts, the drop weight; the s
 beds        a ball on a bed of particles (lattice or poured)
 poured_bed  beds poured and settled under gravity, and their cache
 """
-from yadebreak.scenes.impacts import (drop_weight_scene, hertz_engines, impact_again,  # noqa: F401
-                                      impact_scene, run_scenes, run_until_rebound, scene_seed,
-                                      single_impacts)
-from yadebreak.scenes.beds import (BALL_DIAMETER, BALL_MASS, bed_impact_scene,  # noqa: F401
-                                   hex_bed_positions, hold_release)
+from .beds import (BALL_DIAMETER, BALL_MASS, bed_impact_scene,  # noqa: F401
+                   hex_bed_positions, hold_release)
+from .impacts import (drop_weight_scene, hertz_engines, impact_again,  # noqa: F401
+                      impact_scene, run_scenes, run_until_rebound, scene_seed, single_impacts)

@@ -14,7 +14,7 @@ from yadebreak.coupling import add_materials, attach, run_steps
 from yadebreak.coupling.rolling import rolling_engine
 from yadebreak.coupling.scene_materials import rolling_friction
 from yadebreak.coupling.yade_api import O, geom, utils, wrapper as _w
-from yadebreak.scenes.impacts import hertz_engines, scene_seed
+from .impacts import hertz_engines, scene_seed
 
 
 BALL_DIAMETER = 0.088          # m, the paper's steel ball

@@ -15,7 +15,7 @@ from yadebreak.coupling import add_materials, attach, run_steps
 from yadebreak.coupling.rolling import rolling_engine
 from yadebreak.coupling.scene_materials import rolling_friction
 from yadebreak.coupling.yade_api import O, utils, wrapper as _w
-from yadebreak.tools.options import stop_point, stop_points
+from yadebreak.tools.lifecycle import stop_point, stop_points
 
 
 def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False, rolling=None):
@@ -131,7 +131,14 @@ def run_scenes(spec, which, event_log=None, on_scene=None):
 
 def _in_workers(spec, jobs, event_log, on_scene):
     """single_impacts in `jobs` YADE processes; their tallies merged, their logs joined in scene
-    order. A worker that fails stops the others and raises with its last words."""
+    order. A worker that fails stops the others and raises with its last words.
+
+    Why not the sweeps' Dask pool (tools.sweep): a Dask task reports only when it ends, while
+    these workers write their tallies after every scene (the parent's progress lines and the
+    partial results a killed run keeps), and a LocalCluster costs 6-8 s to start on this 2-core
+    machine against 3.5 s for a YADE process (measured with `python3 -m yadebreak sweep`'s
+    connect('local:2') and `yade -n -x /dev/null`). The two share the launch rule: children die
+    with their parent (tools.sweep.die_with_parent)."""
     import shutil
     import subprocess
     import tempfile
@@ -146,10 +153,10 @@ def _in_workers(spec, jobs, event_log, on_scene):
     (folder / "spec.json").write_text(json.dumps(spec))
     worker = str(Path(__file__).resolve().parents[1] / "runs" / "impact_worker.py")
     errors = [open(folder / f"{j}.err", "w") for j in range(jobs)]
-    from yadebreak.tools.sweep import _die_with_parent       # a parent killed (even -9) takes them along
+    from yadebreak.tools.sweep import die_with_parent    # a parent killed (even -9) takes them along
     procs = [subprocess.Popen(["yade", "-n", "-x", worker, str(folder), str(j), str(jobs)],
                               stdout=subprocess.DEVNULL, stderr=errors[j],
-                              preexec_fn=_die_with_parent) for j in range(jobs)]
+                              preexec_fn=die_with_parent) for j in range(jobs)]
     try:
         reported = 0
         while True:

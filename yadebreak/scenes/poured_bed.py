@@ -22,7 +22,7 @@ import math
 import os
 from pathlib import Path
 
-from yadebreak.model import placement
+from yadebreak.model import cache, placement
 from yadebreak.coupling import rolling
 from yadebreak.coupling.yade_api import O, utils, wrapper
 
@@ -51,13 +51,8 @@ class Settled:
 
 
 def cache_folder(given=""):
-    """The cache of settled beds: `given`, else $YADEBREAK_CACHE, else ~/.cache/yadebreak/beds."""
-    if given:
-        return Path(given)
-    if os.environ.get("YADEBREAK_CACHE"):
-        return Path(os.environ["YADEBREAK_CACHE"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "yadebreak" / "beds"
+    """The cache of settled beds: `given` (--bed-cache), else <cache>/beds (yadebreak.model.cache)."""
+    return cache.cache_folder("beds", given)
 
 
 def cache_key(spec, materials):
@@ -137,14 +132,26 @@ def _locked(path):
             fcntl.flock(lock, fcntl.LOCK_UN)
 
 
+def _cached_files(folder, key):
+    """(scene, meta) of `key` in `folder`; a bed cached by version 0.2 where it kept beds
+    ($YADEBREAK_CACHE itself) is moved into the default folder, so that it still loads."""
+    scene, meta = folder / f"{key}.yade.gz", folder / f"{key}.json"
+    if not scene.exists() and folder == cache_folder():
+        for old in cache.legacy_folders("beds"):
+            if (old / f"{key}.yade.gz").exists() and (old / f"{key}.json").exists():
+                folder.mkdir(parents=True, exist_ok=True)
+                os.replace(old / f"{key}.json", meta)
+                os.replace(old / f"{key}.yade.gz", scene)
+    return scene, meta
+
+
 def cached_scene(folder, key, build):
     """The settled scene `key` from the cache `folder` (None: no cache), else `build()` (which
     makes it in O and returns (bodies, Settled), bodies a dict of ids) saved there. Returns
     (bodies, Settled)."""
     if folder is None:
         return build()
-    scene = Path(folder) / f"{key}.yade.gz"
-    meta = Path(folder) / f"{key}.json"
+    scene, meta = _cached_files(Path(folder), key)
     with _locked(scene):
         cached = scene.exists() and meta.exists()
         if not cached:

@@ -199,13 +199,13 @@ def run_job(argv, folder, env, cwd):
     with open(folder / "log.txt", "w") as log:
         code = subprocess.call(list(argv), stdout=log, stderr=subprocess.STDOUT,
                                stdin=subprocess.DEVNULL, env=environment, cwd=cwd,
-                               preexec_fn=_die_with_parent)
+                               preexec_fn=die_with_parent)
     wall = time.time() - start
     message = "" if code == 0 else _error_line(folder / "log.txt")
     return {"exit_code": code, "wall_s": wall, "worker": _worker_name(), "message": message}
 
 
-def _die_with_parent():
+def die_with_parent():
     """In the child, before exec: be sent SIGTERM when the worker that started us goes (Linux's
     PR_SET_PDEATHSIG), so that a stopped sweep leaves no YADE running."""
     try:

@@ -19,7 +19,7 @@ import numpy as np
 from scipy import optimize, stats
 
 from yadebreak import model
-from yadebreak.tools.calibration.mle import CHI2_95, Coord, Estimate, FitError, MLResult
+from .mle import CHI2_95, Coord, Estimate, FitError, MLResult
 
 CHI2_95_2DOF = float(stats.chi2.ppf(0.95, 2))
 COORDS = [Coord("e_min_ref", "J/kg", "identity", 0.0, math.inf),

@@ -12,8 +12,8 @@ from pathlib import Path
 from yadebreak.model.materials import MaterialError, load_material
 from yadebreak.tools.options import ScriptParser, fail
 from yadebreak.tools.calibration import data, outputs
-from yadebreak.tools.calibration.fit import apply_bootstrap, bootstrap, fit_all
-from yadebreak.tools.calibration.mle import FitError
+from .fit import apply_bootstrap, bootstrap, fit_all
+from .mle import FitError
 
 def parser():
     p = ScriptParser(prog="python3 -m yadebreak fit", description=(

@@ -16,7 +16,7 @@ import numpy as np
 from scipy import stats
 
 from yadebreak import model
-from yadebreak.tools.calibration.mle import Coord, fit
+from .mle import Coord, fit
 
 #: the Hessian's step in ln gamma spans many quadrature points (F_k is interpolated between them)
 COORDS = [Coord("gamma", "-", "log", math.log(0.2), math.log(200.0), step=0.02)]

@@ -9,7 +9,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from yadebreak.tools.calibration import ab_t10, damage, data, fracture, progeny, t10
-from yadebreak.tools.calibration.mle import Estimate, FitError
+from .mle import Estimate, FitError
 
 #: the material-file parameters of each model (breakage table), in the order they are written
 TAVARES_KEYS = ("e_inf", "d0", "phi", "sigma", "emax_ratio", "gamma", "A", "b_prime")

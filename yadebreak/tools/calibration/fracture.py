@@ -19,7 +19,7 @@ from scipy import stats
 
 from yadebreak import model
 from yadebreak.model.intervals import PARTICLE_SIZE
-from yadebreak.tools.calibration.mle import Coord, FitError, fit
+from .mle import Coord, FitError, fit
 
 #: the fitted coordinates: ln Einf, ln d0 (mm), phi, ln sigma, ln(E50/Emax) (Emax/E50 up to 1e4)
 COORDS = {

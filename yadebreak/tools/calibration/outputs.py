@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 
-from yadebreak.tools.calibration.fit import AB_T10_KEYS, TAVARES_KEYS
+from .fit import AB_T10_KEYS, TAVARES_KEYS
 
 UNITS = {"e_inf": "J/kg", "d0": "mm", "phi": "-", "sigma": "-", "emax_ratio": "-", "gamma": "-",
          "A": "%", "b_prime": "-", "e_min_ref": "J/kg", "size_ref": "mm", "selection": "kg/J",
@@ -158,7 +158,7 @@ def plots(cal, out):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from yadebreak.tools.calibration.plots import FIGURES
+    from .plots import FIGURES
     paths = []
     for name, draw in FIGURES:
         fig = draw(cal, plt)

@@ -10,7 +10,7 @@ import math
 
 
 from yadebreak import model
-from yadebreak.tools.calibration.mle import Coord, least_squares
+from .mle import Coord, least_squares
 
 
 def coords(n):

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from yadebreak import model
-from yadebreak.tools.calibration.mle import Coord, least_squares
+from .mle import Coord, least_squares
 
 COORDS = [Coord("A", "%", "identity", 0.1, 100.0),
           Coord("b_prime", "-", "log", math.log(1e-5), math.log(10.0))]

@@ -12,8 +12,8 @@ per module:
 - reference: closed forms the integration is tested against (Reid's solution).
 """
 from yadebreak.tools.grinding.classes import SizeClasses, feed_masses, read_psd_csv, root2_classes
-from yadebreak.tools.grinding.spectra import (Spectra, SpectraError, from_mill_run, read_spectra, synthetic_spectra,
-                      write_spectra)
+from yadebreak.tools.grinding.spectra import (Spectra, SpectraError, from_mill_run, read_spectra,
+                                              synthetic_spectra, write_spectra)
 from yadebreak.tools.grinding.capture import CaptureModel
 from yadebreak.tools.grinding.population import BatchGrinder, GrindingError, GrindResult
 from yadebreak.tools.grinding.reference import reid_batch

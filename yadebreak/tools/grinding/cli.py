@@ -12,12 +12,11 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak.model.materials import load_material
-from yadebreak.tools.options import progress
-from yadebreak.tools.grinding.classes import (FeedError, class_label, feed_masses, feed_top_sieve, read_psd_csv,
+from yadebreak.tools.lifecycle import progress
+from .classes import (FeedError, class_label, feed_masses, feed_top_sieve, read_psd_csv,
                       root2_classes)
-from yadebreak.tools.grinding.population import BatchGrinder, GrindingError
-from yadebreak.tools.grinding.spectra import (SpectraError, from_mill_run, read_spectra, synthetic_spectra,
-                      write_spectra)
+from .population import BatchGrinder, GrindingError
+from .spectra import SpectraError, from_mill_run, read_spectra, synthetic_spectra, write_spectra
 
 #: the names a spectra file takes in a run's folder
 SPECTRA_NAME = "spectra.csv"

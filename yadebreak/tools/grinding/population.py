@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from yadebreak import model
-from yadebreak.tools.grinding.capture import CaptureModel
-from yadebreak.tools.grinding.classes import SizeClasses
+from .capture import CaptureModel
+from .classes import SizeClasses
 
 
 class GrindingError(ValueError):

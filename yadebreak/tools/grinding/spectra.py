@@ -19,7 +19,7 @@ import numpy as np
 
 from yadebreak.model import milling
 from yadebreak.model.materials import load_material
-from yadebreak.tools.grinding.capture import CaptureModel
+from .capture import CaptureModel
 
 FORMAT = "yadebreak-spectra"
 VERSION = 1
