@@ -9,11 +9,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
-from yadebreak.model.intervals import Interval
+from yadebreak.model.intervals import InputError, Interval
 
 
-class AttachError(RuntimeError):
-    """A scene or an option that yadebreak cannot work with; the message says what to change."""
+class AttachError(InputError, RuntimeError):
+    """A scene or an option that yadebreak cannot work with; the message says what to change
+    (a RuntimeError too, as it was first)."""
 
 
 @dataclass(frozen=True)

@@ -1,11 +1,17 @@
 """Ranges of accepted numbers, one home for the check and its wording: the scripts' options
-(scriptargs) and attach()'s options (coupling.config) both check their values with it; the
+(tools.options) and attach()'s options (coupling.config) both check their values with it; the
 physical ranges of material properties below are checked in material files and scenes. Model
 layer: no YADE."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+
+class InputError(ValueError):
+    """A user's input that yadebreak does not accept (an option, a file's field, a scene): the
+    message names it, the value, the accepted range and the unit. Scripts report it in one line
+    with exit code 2 (tools.lifecycle.run_script); every layer's own input errors derive from it."""
 
 
 @dataclass(frozen=True)

@@ -233,7 +233,13 @@ def read(job, description=None, argv=None):
     sys.argv[1:]) or a yade-batch table row: an argparse.Namespace. A bad value ends the program
     with its one line (exit code 2)."""
     declare, check = JOBS[job]
-    args = script_params(declare(), description, argv)
+    args = script_params(declare(), description, argv, table_row=_table_row)
     if check is not None:
         check(args)
     return args
+
+
+def _table_row(defaults):
+    """A yade-batch row's values (yade-batch runs the script inside YADE)."""
+    from yadebreak.coupling.yade_api import table_row
+    return table_row(defaults)

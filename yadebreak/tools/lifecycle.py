@@ -20,9 +20,11 @@ import warnings
 from contextlib import contextmanager
 from pathlib import Path
 
+from yadebreak.model.intervals import InputError
+
 from .options import debugging, fail, script_option_names
 
-class ScriptError(ValueError):
+class ScriptError(InputError):
     """A user's mistake that a script reports in one line (exit code 2), e.g. a resume with other
     arguments."""
 
@@ -45,7 +47,6 @@ def run_script(main, *args):
     143 for SIGTERM); a full disk 1; any other error its traceback, then 1. The last line names
     only the outputs that exist (kept_outputs). The one place where scripts turn exceptions into
     exit codes."""
-    from yadebreak.coupling.config import AttachError
     from yadebreak.model.materials import MaterialError
     out = getattr(args[0], "out", None) if args else None
     began = time.time()
@@ -64,7 +65,7 @@ def run_script(main, *args):
         if debugging():
             raise
         message = f"{exc.source}: " + "; ".join(exc.problems)
-    except (ScriptError, AttachError, FileNotFoundError) as exc:
+    except (InputError, FileNotFoundError) as exc:     # attach()'s, the scripts', ...
         if debugging():
             raise
         message = str(exc)
@@ -371,13 +372,12 @@ def warnings_shown_once():
     run of several scenes would repeat it per scene), naming the script's own option where the
     warning names an attach() option that the script exposes (--read-period for read_period).
     Python's display, and its filters, are back after the block: library use keeps them."""
-    from yadebreak.coupling.controller import YadebreakWarning
     shown = set()
     with warnings.catch_warnings():         # restores showwarning and the filters on leaving
         python_show = warnings.showwarning
 
         def show(message, category, filename, lineno, file=None, line=None):
-            if not issubclass(category, YadebreakWarning):
+            if not hasattr(message, "for_script"):      # not a coupling.YadebreakWarning
                 return python_show(message, category, filename, lineno, file, line)
             if message.cause in shown:
                 return None

@@ -8,13 +8,14 @@ Each option is declared once, with its type, accepted range, unit, default and h
         text("out", "out/x", "output folder"),
     ], __doc__)
 
-Under yade-batch (YADE_BATCH set), yade.utils.readParamsFromTable supplies the values; otherwise
-argparse reads sys.argv. Either way every value is checked against its declaration before anything
+Under yade-batch (YADE_BATCH set), the table's row supplies the values (the caller's table_row:
+readParamsFromTable through coupling.yade_api; this module never imports yade); otherwise argparse
+reads sys.argv. Either way every value is checked against its declaration before anything
 runs: a bad value stops with one line on stderr naming the option, the value, the accepted range
 and the unit (`[yadebreak] error: --energy = -1: must be > 0 (J)`), exit code 2, as argparse does;
 `--debug 1` shows the traceback instead. Units: plain numbers are SI (m, s, J, J/kg, m/s); the
 option's own unit may follow the number (`--size 5.5mm`, `--energy 3.05J`, `--energies
-100J/kg,200J/kg`), another one is refused. Never imports yade unless yade-batch runs it.
+100J/kg,200J/kg`), another one is refused.
 
 How a run goes once its options are read (exit codes, signals, the lock on --out, checkpoints,
 partial results, finish markers, progress lines) is yadebreak.tools.lifecycle's; the options of
@@ -358,16 +359,17 @@ def join_negative_values(argv, params):
     return out
 
 
-def script_params(params, description=None, argv=None):
+def script_params(params, description=None, argv=None, table_row=None):
     """The checked values of a script's options (an argparse.Namespace). `params`: a list of
-    Param (or a {name: default} dict, types following the defaults). Adds --debug."""
+    Param (or a {name: default} dict, types following the defaults). Adds --debug. Under
+    yade-batch, `table_row(defaults)` gives the row's values and description (the YADE layers
+    pass coupling.yade_api.table_row: this module never imports YADE)."""
     if isinstance(params, dict):
         params = _from_defaults(params)
     params = [p for p in params if p.name != "debug"] + [DEBUG]
     _SCRIPT_OPTIONS.clear()
     _SCRIPT_OPTIONS.update(p.name for p in params)
-    if os.environ.get("YADE_BATCH"):
-        from yadebreak.coupling.yade_api import table_row
+    if os.environ.get("YADE_BATCH") and table_row is not None:
         defaults = {p.name: p.default for p in params}
         row, description = table_row(defaults)
         values = argparse.Namespace(**row)
