@@ -3,7 +3,8 @@ interactions, for a few contacts; numpy over the rows kept, with new contacts lo
 around the bodies whose count of interactions changed, for many) read the same scene alike: the
 same contacts with the same numbers bit for bit, the same energies (to round-off: the rows are
 summed in another order), strongest contacts and growing bodies, through impacts, breakage,
-zeroed and sleeping pairs and inherited contacts, with and without shear work."""
+zeroed and sleeping pairs and inherited contacts, with and without shear work. The physics both
+call (HertzMindlinWork, own_share) is tested on closed forms in test_engine_parts.py."""
 import numpy as np
 import pytest
 

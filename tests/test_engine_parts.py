@@ -149,6 +149,74 @@ def test_ab_t10_accumulates_e_minus_e_min_per_loading_and_breaks_past_its_thresh
     assert t10 == pytest.approx(float(mat.t10_of_cumulative_energy(extra["e_cum"], 5.5e-3)))
 
 
+# -- the contact work law on closed forms -------------------------------------------------------
+KNO = 3.2e9          # N/m^1.5, a copper-ore sphere of a few mm on steel
+
+
+def _work(law, d0, f0, delta, force, first_touch=0.8):
+    """A contact's work on floats (as the reader reads a few contacts), checked to the last bit
+    against the same contact among arrays (as it reads many)."""
+    one = (law.from_overlap(d0, f0, KNO, delta, force, math.sqrt) if d0 > 0.0 else
+           law.from_first_touch(KNO, delta, force, first_touch, math.sqrt))
+    many = law.loading(np.array([d0, 2e-6]), np.array([f0, KNO * 2e-6 ** 1.5]),
+                       np.array([KNO, KNO]), np.array([delta, 3e-6]),
+                       np.array([force, KNO * 3e-6 ** 1.5]), first_touch)
+    assert isinstance(one, float) and many[0] == one
+    return one
+
+
+def test_hertz_normal_work_is_two_fifths_k_d_to_the_five_halves():
+    from yadebreak.coupling.contacts import HertzMindlinWork as law
+    overlaps = np.linspace(0.0, 4e-6, 41)[1:]
+    force = KNO * overlaps ** 1.5
+    # from first touch in one read (the elastic force has no dashpot part)...
+    assert _work(law, 0.0, 0.0, 4e-6, force[-1]) == pytest.approx(0.4 * KNO * 4e-6 ** 2.5,
+                                                                   rel=1e-14)
+    # ...and read by read: the Hertz part is exact, whatever the reads
+    total = _work(law, 0.0, 0.0, overlaps[0], force[0]) + sum(
+        _work(law, d0, f0, d1, f1) for d0, f0, d1, f1 in zip(overlaps[:-1], force[:-1],
+                                                            overlaps[1:], force[1:]))
+    assert total == pytest.approx(0.4 * KNO * 4e-6 ** 2.5, rel=1e-12)
+
+
+def test_a_constant_dashpot_force_adds_its_force_times_the_displacement():
+    from yadebreak.coupling.contacts import HertzMindlinWork as law
+    d0, d1, dashpot = 1e-6, 3e-6, 0.7
+    work = _work(law, d0, KNO * d0 ** 1.5 + dashpot, d1, KNO * d1 ** 1.5 + dashpot)
+    assert work == pytest.approx(0.4 * KNO * (d1 ** 2.5 - d0 ** 2.5) + dashpot * (d1 - d0),
+                                 rel=1e-12)
+    # from first touch, the dashpot's work is first_touch x F d (Mindlin's delta^(1/4) growth)
+    work = _work(law, 0.0, 0.0, d1, KNO * d1 ** 1.5 + dashpot, first_touch=0.8 - 0.3 / 9)
+    assert work == pytest.approx(0.4 * KNO * d1 ** 2.5 + (0.8 - 0.3 / 9) * dashpot * d1,
+                                 rel=1e-12)
+    assert law.first_touch_factor(3) == 0.8 - 0.3 / 9
+    assert law.trapezoid(1.0, 2.0, 3.0, 4.0) == 6.0        # the shear work: 0.5 (2 + 4) (3 - 1)
+
+
+def test_a_contact_that_peaked_between_reads_counts_its_work_to_the_parabola_top():
+    from yadebreak.coupling.contacts import HertzMindlinWork as law
+    peak, t_peak, a = 5e-6, 2.4e-6, 1e6         # m, s, m/s^2: overlap = peak - a (t - t_peak)^2
+    times = np.array([1e-6, 2e-6, 3e-6])        # reads at t0 < t1 < t2, the top between t1, t2
+    x0, x1, x2 = peak - a * (times - t_peak) ** 2
+    assert law.peaked(x1, x2, x0, times[0], times[1])
+    assert law.peaked(np.array([x1]), np.array([x2]), np.array([x0]), times[:1], times[1:2])[0]
+    assert not law.peaked(x1, x1 * 1.01, x0, times[0], times[1])       # still growing
+    work = law.past_peak(x1, KNO * x1 ** 1.5, KNO, x0, times[0], times[1], times[2], x2)
+    assert work == pytest.approx(0.4 * KNO * (peak ** 2.5 - x1 ** 2.5), rel=1e-9)
+    # no top above the last overlap read (a convex fall): nothing counts
+    assert law.past_peak(x1, KNO * x1 ** 1.5, KNO, x1 + 1e-6, times[0], times[1], times[2],
+                         x1 - 0.5e-6) is None
+
+
+def test_a_body_counts_its_share_of_a_contacts_work_since_its_offset_from_emin_on():
+    from yadebreak.coupling.contacts import own_share, total_work
+    assert total_work(2.0, 4.0, 0.5) == 4.0 and total_work(2.0, 4.0, 0.0) == 2.0
+    assert own_share(3.0, 1.0, 0.25, 1e-4) == (True, 0.5)
+    assert own_share(3.0, 3.0 - 5e-5, 0.25, 1e-4)[0] is False
+    counted, share = own_share(np.array([3.0, 3.0]), np.array([1.0, 3.0 - 5e-5]), 0.25, 1e-4)
+    assert counted.tolist() == [True, False] and share[0] == 0.5
+
+
 # -- the judge: body by body and with numpy, the same ---------------------------------------------
 def _scene(seed):
     rng = np.random.default_rng(seed)

@@ -180,3 +180,18 @@ def test_sampling_uses_the_generator(tmp_path):
     a = cu.sample_fracture_energy(np.random.default_rng(5), np.full(10, 5.5e-3))
     b = cu.sample_fracture_energy(np.random.default_rng(5), np.full(10, 5.5e-3))
     np.testing.assert_array_equal(a, b)
+
+
+def test_the_criterion_is_chosen_once_by_the_material_and_the_coupling_follows_it():
+    """The material's file names its criterion (Material.criterion, from one registry); YADE's
+    side of each criterion is picked by the same name."""
+    from yadebreak.coupling import criteria
+    from yadebreak.model.materials import CRITERIA
+    assert set(CRITERIA) == set(criteria._CRITERIA)
+    for name in available_materials():
+        mat = load_material(name)
+        assert mat.criterion.name == (mat.breakage_model or "tavares")
+        assert mat.is_ab_t10 == (mat.criterion.name == "ab_t10")
+        if mat.breakable:
+            assert type(criteria.criterion_for(mat)) is criteria._CRITERIA[mat.criterion.name]
+            assert mat.t10_ceiling == (mat.t10_max if mat.is_ab_t10 else mat.A)

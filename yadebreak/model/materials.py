@@ -21,7 +21,7 @@ from typing import Mapping
 import numpy as np
 
 from yadebreak import model
-from yadebreak.model.intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS
+from .intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS, InputError
 
 #: the materials shipped with the package
 MATERIALS_DIR = Path(__file__).resolve().parent.parent / "data" / "materials"
@@ -29,7 +29,7 @@ MATERIALS_DIR = Path(__file__).resolve().parent.parent / "data" / "materials"
 _N_KEYS = {"1.2": 1.2, "1.5": 1.5, "2": 2.0, "4": 4.0, "25": 25.0, "50": 50.0, "75": 75.0}
 
 
-class MaterialError(ValueError):
+class MaterialError(InputError):
     """A material file that cannot be used. `problems` lists every problem found, one per line."""
 
     def __init__(self, source, problems):
@@ -82,7 +82,14 @@ class Material:
     t10_max: float | None = None         # M, %
 
     @property
+    def criterion(self):
+        """This material's breakage criterion (an object of CRITERIA, named by its file's
+        breakage.model; Tavares when none): the one place where the criterion is chosen."""
+        return CRITERIA[self.breakage_model or "tavares"](self)
+
+    @property
     def is_ab_t10(self):
+        """The criterion is Ab-T10 (for outputs and callers; this module asks `criterion`)."""
         return self.breakage_model == "ab_t10"
 
     # -- stiffness ---------------------------------------------------------------------------
@@ -95,7 +102,7 @@ class Material:
         """Eq. 4: share of a contact's energy this material absorbs against `other` (a Material)."""
         return float(model.energy_partition(self.hertz_stiffness, other.hertz_stiffness))
 
-    # -- breakage ----------------------------------------------------------------------------
+    # -- breakage: the criterion's, asked of `criterion` ---------------------------------------
     def _need_breakable(self, what):
         if not self.breakable:
             raise ValueError(f"material '{self.name}' is not breakable: it has no {what}")
@@ -104,10 +111,7 @@ class Material:
         """Eq. 3: E50 (J/kg) at particle size `size` (m), against this material's device stiffness.
         Ab-T10: the e_cum at which half the particles of that size break (Eq. 9.3 at u = 0.5)."""
         self._need_breakable("fracture energy")
-        if self.is_ab_t10:
-            return self.fracture_energy_ppf(0.5, size)
-        return model.median_fracture_energy(size, self.e_inf, self.d0, self.phi,
-                                            self.hertz_stiffness, self.device_stiffness)
+        return self.criterion.median_fracture_energy(size)
 
     def min_energy(self, size):
         """Ab-T10, Eq. 9.1: e_min (J/kg) at size `size` (m)."""
@@ -118,48 +122,35 @@ class Material:
         """Probability that a particle of size `size` (m) has its fracture energy below `energy`:
         Eqs. 1-3 (Tavares); Eq. 9.3 (Ab-T10, where the fracture energy is the e_cum at which the
         particle breaks)."""
-        if self.is_ab_t10:
-            return model.ab_t10_probability(energy, size, self.min_energy(size), self.selection,
-                                            self.size_ref)
-        return model.fracture_energy_cdf(energy, self.median_fracture_energy(size), self.sigma,
-                                         self.emax_ratio)
+        return self.criterion.fracture_energy_cdf(energy, size)
 
     def fracture_energy_ppf(self, u, size):
         """The fracture energy (J/kg) at probability u for size `size` (m): Eqs. 1-3 inverted
         (Tavares); the e_cum threshold of strength u (Ab-T10, Eq. 9.3 inverted)."""
-        if self.is_ab_t10:
-            return model.ab_t10_threshold(u, size, self.min_energy(size), self.selection,
-                                          self.size_ref)
-        return model.fracture_energy_ppf(u, self.median_fracture_energy(size), self.sigma,
-                                         self.emax_ratio)
+        return self.criterion.fracture_energy_ppf(u, size)
 
     def sample_fracture_energy(self, rng, size):
         """One fracture energy (J/kg) per size in `size` (m), from Generator `rng`: Eqs. 1-3
         (Tavares); for Ab-T10 the e_cum threshold of a strength drawn uniform in [0, 1)."""
-        size = np.asarray(size, dtype=float)
-        if self.is_ab_t10:
-            return self.fracture_energy_ppf(rng.random(size.shape), size)
-        return model.sample_fracture_energy(rng, self.median_fracture_energy(size), self.sigma,
-                                            self.emax_ratio, size=size.shape)
+        return self.criterion.sample_fracture_energy(rng, np.asarray(size, dtype=float))
+
+    def absorbed(self, specific_energy, partner=None):
+        """e Ek/mp (J/kg): the share (Eq. 4) of `specific_energy` = Ek/mp (J/kg) this material
+        absorbs against `partner` (a Material; None: the energy given is already absorbed)."""
+        share = 1.0 if partner is None else self.energy_partition(partner)
+        return share * np.asarray(specific_energy, dtype=float)
 
     def breakage_probability(self, specific_energy, size, partner=None):
         """Probability that a fresh particle of size `size` (m) breaks when a contact brings it
         `specific_energy` = Ek/mp (J/kg), of which it absorbs e (Eq. 4) against `partner`
         (a Material; None means the energy given is already Ek'/mp).
         Ab-T10: P(e_cum) of the e_cum one such loading leaves (Eqs. 9.2-9.3, small steps)."""
-        share = 1.0 if partner is None else self.energy_partition(partner)
-        absorbed = share * np.asarray(specific_energy, dtype=float)
-        if self.is_ab_t10:
-            absorbed = model.ab_t10_single_impact_cum(absorbed, self.min_energy(size))
-        return self.fracture_energy_cdf(absorbed, size)
+        return self.criterion.probability_once(self.absorbed(specific_energy, partner), size)
 
     def t10(self, ratio):
         """Eq. 8 with this material's A, b' and kappa; ratio = Ek' / (mp E). Tavares only."""
         self._need_breakable("t10")
-        if self.is_ab_t10:
-            raise ValueError(f"material '{self.name}' uses Ab-T10: its t10 comes from e_cum "
-                             "(t10_of_cumulative_energy), not from Eq. 8")
-        return model.t10(ratio, self.A, self.b_prime, self.kappa)
+        return self.criterion.t10(ratio)
 
     def t10_model(self, specific_energy, size, partner=None):
         """The model's t10 (%) of particles of size `size` (m) each stressed once with
@@ -169,15 +160,7 @@ class Material:
         particles that break: each breaks when e_cum reaches its strength u (uniform), with
         t10 = M u, so the mean is M P / 2, P = P(e_cum) of one such loading. NaN where no particle
         breaks."""
-        share = 1.0 if partner is None else self.energy_partition(partner)
-        absorbed = share * np.asarray(specific_energy, dtype=float)
-        if self.is_ab_t10:
-            e_cum = model.ab_t10_single_impact_cum(absorbed, self.min_energy(size))
-            t10 = 0.5 * self.t10_of_cumulative_energy(e_cum, size)
-            return np.where(t10 > 0.0, t10, np.nan)
-        e50b = model.median_fracture_energy_broken(absorbed, self.median_fracture_energy(size),
-                                                   self.sigma, self.emax_ratio)
-        return model.t10_batch(absorbed, e50b, self.A, self.b_prime)
+        return self.criterion.t10_once(self.absorbed(specific_energy, partner), size)
 
     def t10_of_cumulative_energy(self, e_cum, size):
         """Ab-T10, Eq. 9.4: t10 (%) of a particle of size `size` (m) broken at e_cum (J/kg)."""
@@ -189,14 +172,12 @@ class Material:
         """The smallest t10' (%) a breakage gives: Eq. 9 (Tavares). Ab-T10's t10 = M P(e_cum)
         has no floor; below AB_T10_T10_FLOOR % events take the family set of that floor."""
         self._need_breakable("t10")
-        if self.is_ab_t10:
-            return min(AB_T10_T10_FLOOR, 0.5 * self.t10_max)
-        return float(model.t10_primary(self.A, self.b_prime, self.kappa))
+        return self.criterion.t10_min
 
     @property
     def t10_ceiling(self):
         """The largest t10' (%): A (Tavares, Eq. 8) or M (Ab-T10, Eq. 9.4)."""
-        return self.t10_max if self.is_ab_t10 else self.A
+        return self.criterion.t10_ceiling
 
     def contact_with(self, other):
         """Contact parameters (Table 6) for the pair (self, other).
@@ -248,8 +229,6 @@ _AB_T10 = [
     ("selection", 0.0, False, math.inf, False, "kg/J", 1.0),
     ("t10_max", 0.0, False, 100.0, True, "%", 1.0),
 ]
-#: breakage.model -> (its keys, the defaults of the optional ones)
-_MODELS = {"tavares": (_TAVARES, {"emax_ratio": 100.0, "kappa": 1.0}), "ab_t10": (_AB_T10, {})}
 #: Ab-T10 events with t10 below this (%) take the family set at this t10 (see Material.t10_min):
 #: below it the 11 classes cannot follow Eq. 10 within 2 % (2.6 % at t10 = 1 %).
 AB_T10_T10_FLOOR = 2.0
@@ -258,6 +237,190 @@ _CONTACT = [
     ("rolling_friction", 0.0, True, 10.0, True, "-", 1.0),
     ("restitution", 0.0, False, 1.0, True, "-", 1.0),
 ]
+
+
+# ------------------------------------------------------------------- the breakage criteria
+class TavaresCriterion:
+    """The Tavares UFRJ model of a material's breakage (Eqs. 1-3, 7-8): what the model layer
+    (Material, reports) asks of a criterion. coupling.criteria holds its counterpart in YADE,
+    picked by the same `name`."""
+
+    name = "tavares"
+    #: [breakage] keys of the file (see _parse_breakage) and the defaults of the optional ones
+    keys, defaults = _TAVARES, {"emax_ratio": 100.0, "kappa": 1.0}
+    #: the plots' legends of the model's breakage probability and t10
+    probability_label = "model (Eqs. 1-4)"
+    t10_label = "model: Eq. 7, e Ek/mp over E50b of the broken particles"
+
+    def __init__(self, material):
+        self.material = material
+
+    #: [breakage] keys beyond `keys`, read by parse_more
+    more_keys = {"device_stiffness"}
+
+    @staticmethod
+    def parse_more(breakage, values, problems):
+        """The keys more_keys of [breakage] into `values` (SI)."""
+        dev = _number(breakage, "device_stiffness", "breakage", problems,
+                      *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", required=False,
+                      default=model.DEVICE_STIFFNESS_STEEL / 1e9)
+        values["device_stiffness"] = None if dev is None else dev * 1e9
+
+    def median_fracture_energy(self, size):
+        """Eq. 3: E50 (J/kg) at size `size` (m), against the material's device stiffness."""
+        m = self.material
+        return model.median_fracture_energy(size, m.e_inf, m.d0, m.phi, m.hertz_stiffness,
+                                            m.device_stiffness)
+
+    def fracture_energy_cdf(self, energy, size):
+        """Eqs. 1-3: P(fracture energy < `energy` (J/kg)) at size `size` (m)."""
+        m = self.material
+        return model.fracture_energy_cdf(energy, m.median_fracture_energy(size), m.sigma,
+                                         m.emax_ratio)
+
+    def fracture_energy_ppf(self, u, size):
+        """Eqs. 1-3 inverted: the fracture energy (J/kg) at probability u, size `size` (m)."""
+        m = self.material
+        return model.fracture_energy_ppf(u, m.median_fracture_energy(size), m.sigma, m.emax_ratio)
+
+    def sample_fracture_energy(self, rng, size):
+        """One fracture energy (J/kg) per size (m, an array) from Generator `rng`."""
+        m = self.material
+        return model.sample_fracture_energy(rng, m.median_fracture_energy(size), m.sigma,
+                                            m.emax_ratio, size=size.shape)
+
+    def probability_once(self, absorbed, size):
+        """P that a fresh particle of size `size` (m) breaks when it absorbs `absorbed` (J/kg)."""
+        return self.fracture_energy_cdf(absorbed, size)
+
+    def t10(self, ratio):
+        """Eq. 8 (%); ratio = Ek' / (mp E)."""
+        m = self.material
+        return model.t10(ratio, m.A, m.b_prime, m.kappa)
+
+    def t10_once(self, absorbed, size):
+        """Eq. 7 (%) at `absorbed` (J/kg) over E50b of the particles of size `size` (m) that
+        break at it."""
+        m = self.material
+        e50b = model.median_fracture_energy_broken(absorbed, m.median_fracture_energy(size),
+                                                   m.sigma, m.emax_ratio)
+        return model.t10_batch(absorbed, e50b, m.A, m.b_prime)
+
+    @property
+    def t10_min(self):
+        """Eq. 9 (%)."""
+        m = self.material
+        return float(model.t10_primary(m.A, m.b_prime, m.kappa))
+
+    @property
+    def t10_ceiling(self):
+        """A (%), Eq. 8's largest t10'."""
+        return self.material.A
+
+    def intact_measures(self, e_cum_intact, size):
+        """What the intact particles of an impact test carry for its result: nothing here."""
+        return {}
+
+    #: the repeated-impact plot's legend of the model (see repeated_broken_fraction)
+    repeated_label = "model (Eqs. 1-6), gamma = {gamma:g}"
+
+    def repeated_broken_fraction(self, absorbed, size, impacts):
+        """Eqs. 1-6: the fraction of particles of size `size` (m) broken after each of
+        `impacts` loadings, each absorbing `absorbed` (J/kg), damage weakening the survivors."""
+        m = self.material
+        e50 = float(m.median_fracture_energy(size))
+        return model.repeated_impact_broken_fraction(absorbed, e50, m.sigma, m.emax_ratio,
+                                                     m.gamma, impacts)
+
+
+class AbT10Criterion:
+    """Rocky's Ab-T10 model of a material's breakage (docs/model.md Section 9, Eqs. 9.1-9.4);
+    see TavaresCriterion."""
+
+    name = "ab_t10"
+    keys, defaults = _AB_T10, {}
+    probability_label = "model P(e_cum), e_cum = e Ek/mp - e_min (Eqs. 4, 9.1-9.3)"
+    t10_label = "model: Eq. 9.4"
+
+    def __init__(self, material):
+        self.material = material
+
+    more_keys = set()
+
+    @staticmethod
+    def parse_more(breakage, values, problems):
+        """No keys beyond `keys`."""
+
+    def median_fracture_energy(self, size):
+        """The e_cum (J/kg) at which half the particles of size `size` (m) break."""
+        return self.fracture_energy_ppf(0.5, size)
+
+    def fracture_energy_cdf(self, energy, size):
+        """Eq. 9.3: P(e_cum threshold < `energy` (J/kg)) at size `size` (m)."""
+        m = self.material
+        return model.ab_t10_probability(energy, size, m.min_energy(size), m.selection, m.size_ref)
+
+    def fracture_energy_ppf(self, u, size):
+        """Eq. 9.3 inverted: the e_cum threshold (J/kg) of strength u, size `size` (m)."""
+        m = self.material
+        return model.ab_t10_threshold(u, size, m.min_energy(size), m.selection, m.size_ref)
+
+    def sample_fracture_energy(self, rng, size):
+        """The e_cum threshold (J/kg) of a strength drawn uniform in [0, 1), per size (m)."""
+        return self.fracture_energy_ppf(rng.random(size.shape), size)
+
+    def probability_once(self, absorbed, size):
+        """P(e_cum) of the e_cum one loading absorbing `absorbed` (J/kg) leaves (Eqs. 9.2-9.3)."""
+        m = self.material
+        return self.fracture_energy_cdf(model.ab_t10_single_impact_cum(absorbed,
+                                                                       m.min_energy(size)), size)
+
+    def t10(self, ratio):
+        raise ValueError(f"material '{self.material.name}' uses Ab-T10: its t10 comes from e_cum "
+                         "(t10_of_cumulative_energy), not from Eq. 8")
+
+    def t10_once(self, absorbed, size):
+        """The mean of Eq. 9.4 (%) over the particles that break after one loading absorbing
+        `absorbed` (J/kg): M P / 2; NaN where none breaks."""
+        m = self.material
+        e_cum = model.ab_t10_single_impact_cum(absorbed, m.min_energy(size))
+        t10 = 0.5 * m.t10_of_cumulative_energy(e_cum, size)
+        return np.where(t10 > 0.0, t10, np.nan)
+
+    @property
+    def t10_min(self):
+        """No floor in Eq. 9.4: AB_T10_T10_FLOOR (%), or M / 2 when smaller."""
+        return min(AB_T10_T10_FLOOR, 0.5 * self.material.t10_max)
+
+    @property
+    def t10_ceiling(self):
+        """M (%), Eq. 9.4's largest t10."""
+        return self.material.t10_max
+
+    def intact_measures(self, e_cum_intact, size):
+        """The mean e_cum (J/kg) the intact particles of an impact test carry (what the broken
+        ones would have reached) and P of it."""
+        if not e_cum_intact:
+            return {}
+        e_cum = float(np.mean(e_cum_intact))
+        return {"e_cum_measured": e_cum,
+                "p_of_e_cum_measured": float(self.fracture_energy_cdf(e_cum, size))}
+
+    repeated_label = "model P(e_cum), e_cum = k (e Ek/mp - e_min) (Eqs. 9.1-9.3)"
+
+    def repeated_broken_fraction(self, absorbed, size, impacts):
+        """Eqs. 9.1-9.3: the fraction broken after each of `impacts` loadings, each absorbing
+        `absorbed` (J/kg), e_cum adding up over the impacts."""
+        m = self.material
+        return model.ab_t10_repeated_broken_fraction(absorbed, size, float(m.min_energy(size)),
+                                                     m.selection, m.size_ref, impacts)
+
+
+#: breakage.model -> its criterion: the one registry (coupling.criteria picks its YADE-side
+#: counterpart by the same name)
+CRITERIA = {c.name: c for c in (TavaresCriterion, AbT10Criterion)}
+
+
 _TOP_KEYS = {"name", "description", "kind", "breakable", "contact_like", "elastic", "breakage",
              "contact"}
 #: the kinds of material file: "replacement" (this module's; the default when `kind` is absent)
@@ -384,24 +547,18 @@ def _parse_breakage(doc, values, problems):
     parameters, beta source)."""
     breakage = _read_table(doc, "breakage", "", problems)
     model_name = breakage.get("model", "tavares")
-    if model_name not in _MODELS:
+    if model_name not in CRITERIA:
         problems.append(f"breakage.model = {model_name!r}: accepted 'tavares' (the default) "
                         "or 'ab_t10'")
         model_name = "tavares"
-    fields, defaults = _MODELS[model_name]
-    allowed = {k[0] for k in fields} | {"model", "beta", "beta_source"}
-    if model_name == "tavares":
-        allowed.add("device_stiffness")
-    _check_keys(breakage, allowed, "breakage", problems)
-    for key, lo, lo_inc, hi, hi_inc, unit, factor in fields:
+    criterion = CRITERIA[model_name]
+    allowed = {k[0] for k in criterion.keys} | {"model", "beta", "beta_source"}
+    _check_keys(breakage, allowed | criterion.more_keys, "breakage", problems)
+    for key, lo, lo_inc, hi, hi_inc, unit, factor in criterion.keys:
         v = _number(breakage, key, "breakage", problems, lo, lo_inc, hi, hi_inc, unit,
-                    default=defaults.get(key))
+                    default=criterion.defaults.get(key))
         values[key] = None if v is None else v * factor
-    if model_name == "tavares":
-        dev = _number(breakage, "device_stiffness", "breakage", problems,
-                      *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", required=False,
-                      default=model.DEVICE_STIFFNESS_STEEL / 1e9)
-        values["device_stiffness"] = None if dev is None else dev * 1e9
+    criterion.parse_more(breakage, values, problems)
     beta_source = breakage.get("beta_source", "material")
     if beta_source not in ("material", "table1"):
         problems.append(f"breakage.beta_source = {beta_source!r}: accepted 'material' (the "

@@ -174,11 +174,8 @@ def breakage_result_of(tally, material, specific_energy, partner):
               "broken_fraction": len(broken) / n, "model_probability": p_model,
               "binomial_sigma": float(np.sqrt(p_model * (1 - p_model) / n)),
               "t10_model": t10_model if np.isfinite(t10_model) else None}
-    if material.is_ab_t10 and tally.e_cum_intact:
-        # the e_cum the intact particles carry: what the broken ones would have reached
-        e_cum = float(np.mean(tally.e_cum_intact))
-        result["e_cum_measured"] = e_cum
-        result["p_of_e_cum_measured"] = float(material.fracture_energy_cdf(e_cum, size))
+    # Ab-T10: the e_cum the intact particles carry, what the broken ones would have reached
+    result.update(material.criterion.intact_measures(tally.e_cum_intact, size))
     if not broken:
         result["t10_note"] = "no particle broke: no progeny to measure"
         return result
@@ -259,8 +256,7 @@ def plot_breakage(results, material, size, partner, title, path, label="simulati
     _plot_probability(axes[0], results, material, size, partner, energies, title, label)
     grid = np.geomspace(min(50.0, min(energies) / 2), max(3000.0, 2 * max(energies)), 200)
     axes[1].semilogx(grid, material.t10_model(grid, size, partner), "k-",
-                     label="model: Eq. 9.4" if material.is_ab_t10 else
-                     "model: Eq. 7, e Ek/mp over E50b of the broken particles")
+                     label=material.criterion.t10_label)
     done = [r for r in results if r.get("t10_simulated") is not None]
     if done:
         axes[1].plot([r["specific_energy"] for r in done], [r["t10_simulated"] for r in done],
@@ -299,8 +295,7 @@ def bounded_errors(values, errors, lo=0.0, hi=None):
 def _plot_probability(ax, results, material, size, partner, energies, title, label):
     grid = np.geomspace(min(energies) / 3, max(energies) * 3, 200)
     ax.semilogx(grid, 100 * material.breakage_probability(grid, size, partner=partner), "k-",
-                label=("model P(e_cum), e_cum = e Ek/mp - e_min (Eqs. 4, 9.1-9.3)"
-                       if material.is_ab_t10 else "model (Eqs. 1-4)"))
+                label=material.criterion.probability_label)
     measured = [(r["specific_energy"], r["p_of_e_cum_measured"]) for r in results
                 if "p_of_e_cum_measured" in r]
     if measured:

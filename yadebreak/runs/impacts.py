@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from yadebreak import coupling, model, scenes
+from yadebreak import coupling, scenes
 from yadebreak.coupling.yade_api import O
 from yadebreak.model import reports
 from yadebreak.model.materials import load_material
@@ -157,9 +157,9 @@ class Repeated(skeleton.Job):
         args = self.args
         self.mat = load_material(args.material)
         if args.gamma > 0:
-            if self.mat.is_ab_t10:
+            if self.mat.criterion.name != "tavares":
                 raise ScriptError(f"--gamma applies to Tavares materials; {self.mat.name} uses "
-                                  "Ab-T10")
+                                  f"{self.mat.criterion.name}")
             self.mat = dataclasses.replace(self.mat, gamma=args.gamma)
         self.share = self.mat.energy_partition(load_material(args.target))
         self.speed = float(np.sqrt(2 * args.energy))
@@ -218,17 +218,10 @@ def repeated(args):
 
 def _repeated_outputs(args, mat, share, fractions, brk, out, runtime_s, end_reason, end_message):
     """summary.json (with how the run ended) and the plot, for the impacts done."""
-    if mat.is_ab_t10:
-        model_fractions = model.ab_t10_repeated_broken_fraction(
-            share * args.energy, args.size, float(mat.min_energy(args.size)), mat.selection,
-            mat.size_ref, len(fractions))
-        model_label = "model P(e_cum), e_cum = k (e Ek/mp - e_min) (Eqs. 9.1-9.3)"
-    else:
-        e50 = float(mat.median_fracture_energy(args.size))
-        model_fractions = model.repeated_impact_broken_fraction(share * args.energy, e50,
-                                                                mat.sigma, mat.emax_ratio,
-                                                                mat.gamma, len(fractions))
-        model_label = f"model (Eqs. 1-6), gamma = {mat.gamma:g}"
+    criterion = mat.criterion
+    model_fractions = criterion.repeated_broken_fraction(share * args.energy, args.size,
+                                                         len(fractions))
+    model_label = criterion.repeated_label.format(gamma=mat.gamma)
     absorbed = [e["specific_energy"] for e in brk.events if e["kind"] == "damage"]
     summary = {"material": mat.name, "model": mat.breakage_model, "size": args.size,
                "energy": args.energy, "gamma": mat.gamma,
