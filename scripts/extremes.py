@@ -1,4 +1,4 @@
-"""The stability matrix (issue 7): every input at its extremes, and what each run must satisfy.
+"""The stability matrix: every input at its extremes, and what each run must satisfy.
 
 For each case: no NaN or infinity in any body or event; mass (spheres plus ledger) conserved to
 1e-9; no fragment leaving faster than its parent's rigid velocity field (|v| + 2 |w| r); no kinetic
