@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak import model
+from yadebreak.model.intervals import InputError
 
 #: column name (lower case) -> (quantity, factor to the unit used here: mm, J/kg, %, J, kg)
 COLUMNS = {
@@ -40,7 +41,7 @@ ACCEPTED = ("fracture energies: size_mm,energy_J_per_kg[,broken]; t10: size_mm,e
             "progeny: t10_percent,n,passing_percent")
 
 
-class DataError(ValueError):
+class DataError(InputError):
     """A data file that cannot be used: the message names the file, the line and the column."""
 
     def __init__(self, path, line, column, message):
