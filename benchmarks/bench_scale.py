@@ -1,6 +1,7 @@
-"""Benchmark: the engine's cost at process scale, beside plain YADE (issue 15, item 3).
+"""Benchmark: the engine's cost at process scale, beside plain YADE.
 
     /usr/bin/python3 benchmarks/bench_scale.py [--quick] [--sizes 1000,10000,100000] [--repeats 3]
+                                               [--mill-only]
 
 Two scenes of 5.5 mm copper-ore spheres in a steel box, each built for N bodies:
 - dense: a column on a cubic lattice (each sphere touching its neighbours), under gravity, pressed
@@ -10,8 +11,9 @@ Two scenes of 5.5 mm copper-ore spheres in a steel box, each built for N bodies:
 Each scene runs in plain YADE (no yadebreak), with yadebreak's default (read_period="fast"), and
 with every contact read every step (read_period="every_step"), first with breakage out of reach
 (fracture energies set very high), then, for the collisional scene, with breakage in reach
-(25 m/s). Then: the cost of one breakage event at each size, the default ball mill in the three
-modes, attach() at each size, and yadebreak's memory per body.
+(25 m/s). Then: the cost of one breakage event at each size, the default ball mill in each
+mode (and as the grinding model's spectra run: attach(breakage=False)), attach() at each size,
+and yadebreak's memory per body.
 Prints microseconds per step and ratios measured in this run; --quick runs 1e3 and 1e4 bodies.
 """
 import argparse
@@ -35,7 +37,8 @@ RADIUS = 2.75e-3
 #: times it): the lattice's first contacts settle, the collisions begin
 WARM_UP = 200
 #: the modes compared: attach() options, None for plain YADE
-MODES = {"plain": None, "default": {}, "every step": {"read_period": "every_step"}}
+MODES = {"plain": None, "default": {}, "every step": {"read_period": "every_step"},
+         "spectra run": {"breakage": False}}
 
 
 def _box(lo, hi):
@@ -255,7 +258,10 @@ def main():
     parser.add_argument("--sizes", default=None, help="comma-separated body counts")
     parser.add_argument("--repeats", type=int, default=3,
                         help="runs of each mode up to 1e4 bodies and on the mill (median)")
+    parser.add_argument("--mill-only", action="store_true", help="only the ball mill (part 4)")
     args = parser.parse_args(sys.argv[1:])
+    if args.mill_only:
+        return mill(repeats=args.repeats)
     sizes = ([int(float(s)) for s in args.sizes.split(",")] if args.sizes
              else [1000, 10000] if args.quick else [1000, 10000, 100000])
     attach_times = per_step(sizes, args.repeats)

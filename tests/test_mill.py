@@ -112,3 +112,36 @@ def test_a_resumed_mill_goes_on_from_its_checkpoint_and_refuses_other_arguments(
                                                       abs=200 * whole["final_dt"])
     for key in ("damage_events", "breakage_events"):
         assert abs(resumed[key] - whole[key]) <= 0.1 * whole[key] + 1, key
+
+
+def test_the_spectra_run_breaks_nothing_and_feeds_the_grinding_model(scene, tmp_path):
+    """--breakage 0: the same mill with nothing broken or damaged; every ore stressing event
+    recorded once, by its pair type, into spectra.csv, which `python3 -m yadebreak grind` reads."""
+    import subprocess
+    import sys
+    from yade import O
+    from yadebreak.runs import mill
+    from yadebreak.tools.grinding.spectra import read_spectra
+    brk, summary = mill.run(_args(tmp_path, breakage=False, vtk_interval=0.0), quiet=True)
+    assert summary["breakage"] is False and summary["end_reason"] == "finished"
+    assert summary["breakage_events"] == summary["damage_events"] == 0
+    assert summary["stressing_events"] > 50
+    assert summary["bodies_end"] == summary["bodies_start"] and summary["mass_relative_error"] == 0
+    assert all(brk.bodies[i].damage == 0.0 for i in mill_ore_ids(brk, O))
+    spectra = read_spectra(tmp_path / "spectra.csv")
+    assert spectra.simulated_time_s == pytest.approx(summary["simulated_time"], rel=1e-12)
+    assert spectra.ore_mass_kg == pytest.approx(summary["initial_mass"], rel=1e-12)
+    with_partner = [e for e in brk.events if e["kind"] == "stressing" and e["partner"] >= 0]
+    rates = summary["stressing_events_per_second"]
+    assert sum(rates.values()) * summary["simulated_time"] == pytest.approx(len(with_partner))
+    out = tmp_path / "grind"
+    proc = subprocess.run([sys.executable, "-m", "yadebreak", "grind", str(tmp_path / "spectra.csv"),
+                           "--material", "limestone", "--feed", "6e-3", "--minutes", "0.5",
+                           "--out", str(out)], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-1500:] + proc.stderr[-1500:]
+    ground = json.loads((out / "summary.json").read_text())
+    assert ground["mass_relative_error"] < 1e-9
+
+
+def mill_ore_ids(brk, O):
+    return [b.id for b in O.bodies if b is not None and b.material.label == "ore"]

@@ -90,6 +90,9 @@ OPTIONS = (
     Option("pause_steps", "criteria", None, _count(0, none=True), "an integer >= 0 or None",
            "steps", "steps after its creation during which a fragment counts no energy (Rocky's "
            "safeguard); None: 25 for Ab-T10 materials, 0 for Tavares ones"),
+    Option("breakage", "criteria", True, _boolean, "True or False", "-",
+           "False: nothing breaks or is damaged; every stressing event is recorded (kind "
+           "'stressing', its largest specific energy and partner): a scene's collision spectra"),
     Option("fragments_energy_factor", "criteria", 1.0, _number(0, 1, lo_open=True), "(0, 1]", "-",
            "multiplies the specific energy that fragments see (Rocky's safeguard)"),
     # replacement: what a broken sphere becomes
@@ -141,6 +144,7 @@ class Criteria:
     kappa: float | None
     emax_ratio: float | None
     pause_steps: int | None
+    breakage: bool
     fragments_energy_factor: float
 
 

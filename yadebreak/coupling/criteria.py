@@ -8,6 +8,10 @@ read and write the body columns of state.BodyTable; no yade import.
     breakage(table, i, ek) -> (ratio, t10, extra)     the t10' of a breakage (Eq. 8 or 9.4)
     force(table, i, ratio) -> ek                      a breakage imposed by break_body()
     sample(rng, sizes) -> (fracture energies, extra columns)   state of a new body
+    event_kind                                        what unload()'s events are logged as
+
+Recording (attach(breakage=False)) wraps a material's criterion: nothing breaks or weakens, every
+stressing event is logged as 'stressing'.
 """
 from __future__ import annotations
 
@@ -49,6 +53,9 @@ class Tavares:
     #: costs about 1 us per body, judge with the judge's numpy path 25 us per read plus 0.2 us
     #: per body
     judged_one_by_one = 24
+
+    #: unload()'s events are damage events
+    event_kind = "damage"
 
     def __init__(self, material):
         self.material = material
@@ -106,6 +113,7 @@ class AbT10:
     #: see Tavares: Eq. 9.2 (model.ab_t10_update, numpy on any shape) costs about 20 us per body
     #: one by one, the numpy path about 40 us per read for up to 50 bodies: equal near 2 bodies
     judged_one_by_one = 2
+    event_kind = "damage"
 
     def __init__(self, material):
         self.material = material
@@ -183,13 +191,61 @@ def judge_all(criterion_of, table, ids, active, ek, specific, every=False):
     return out
 
 
+class Recording:
+    """No breakage and no damage (attach(breakage=False)): every stressing event is logged as
+    'stressing' with its largest specific energy and partner, and the body stays as it was: the
+    collision spectra of a scene. The material's own criterion draws the fracture energies (kept
+    for the events' `ratio`); reads follow the loading only."""
+
+    event_kind = "stressing"
+    default_pause_steps = 0
+    judged_one_by_one = Tavares.judged_one_by_one
+
+    def __init__(self, inner):
+        self.inner = inner
+        self.material = inner.material
+        self.order = inner.order
+
+    def sample(self, rng, sizes):
+        return self.inner.sample(rng, sizes)
+
+    def judge(self, table, ids, ek, specific):
+        return Judgement(*self.judge_one(table.columns, ids, ek, specific))
+
+    @staticmethod
+    def judge_one(c, i, ek, specific):
+        """Never a breakage, and no threshold to approach: not `rising`, so that "fast" reads keep
+        only the pace the loading time asks for (the events' peaks), not the closer reads that a
+        body nearing its fracture energy needs."""
+        breaks, level, threshold, rising, rise, jump = Tavares.judge_one(c, i, ek, specific)
+        if isinstance(breaks, np.ndarray):
+            return np.zeros_like(breaks), level, threshold, np.zeros_like(rising), rise, jump
+        return False, level, threshold, False, rise, jump
+
+    def unload(self, table, i):
+        """The event's fields; the body unchanged."""
+        c = table.columns
+        if c["kind"][i] != 1:
+            return None
+        energy = float(c["fracture_energy"][i])
+        return {"fracture_energy": energy,
+                "ratio": float(c["event_max"][i]) / (float(c["mass"][i]) * energy)}
+
+    def breakage(self, table, i, ek):             # break_body() still breaks
+        return self.inner.breakage(table, i, ek)
+
+    def force(self, table, i, ratio):
+        return self.inner.force(table, i, ratio)
+
+
 #: the YADE-side counterpart of each criterion of the model's registry (materials.CRITERIA),
 #: by its name
 _CRITERIA = {"tavares": Tavares, "ab_t10": AbT10}
 
 
-def criterion_for(material):
+def criterion_for(material, breakage=True):
     """The criterion object of a breakable Material: the counterpart of the one its model
-    names (Material.criterion)."""
-    return _CRITERIA[material.criterion.name](material)
+    names (Material.criterion); with breakage=False its Recording."""
+    criterion = _CRITERIA[material.criterion.name](material)
+    return criterion if breakage else Recording(criterion)
 

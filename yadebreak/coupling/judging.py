@@ -186,9 +186,10 @@ class Judge:
         table = self.state.table
         c = table.columns
         event_max, mass = float(c["event_max"][bid]), float(c["mass"][bid])
-        fields = self.criterion_of[c["material"][bid]].unload(table, bid)
+        criterion = self.criterion_of[c["material"][bid]]
+        fields = criterion.unload(table, bid)
         if fields is not None:
-            self.record("damage", bid, specific_energy=event_max / mass,
+            self.record(criterion.event_kind, bid, specific_energy=event_max / mass,
                         partner=int(c["event_partner"][bid]), **fields)
         c["event_max"][bid] = c["specific_energy"][bid] = 0.0
         self.state.open_events.discard(bid)

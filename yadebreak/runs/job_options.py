@@ -113,6 +113,8 @@ def ball_mill():
         number("dmin", 0.0, "m", "smallest resolved fragment; finer progeny goes to the ledger "
                "(0: --size / 3)", lo=0),
         read_period_option("fast"),
+        flag("breakage", True, "0: the spectra run: nothing breaks or is damaged, every stressing "
+             "event of the ore is recorded (spectra.csv, for python3 -m yadebreak grind)"),
         integer("seed", 1, "random seed", lo=0),
         number("sample_interval", 0.02, "s", "simulated time between samples of the size "
                "distribution and the charge", lo=0, lo_open=True),

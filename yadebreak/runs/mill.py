@@ -197,9 +197,9 @@ def pair_type(partner, info):
 def collision_spectra(events, info, duration):
     """Stressing events per second against specific energy (J/kg), per pair type: (bin edges,
     {pair type: (per bin, at or above each lower edge)}), from the engine's damage and breakage
-    events (each ore stressing event once, at its largest energy, with the contact that brought
+    events, or its stressing events in a spectra run (each ore stressing event once, at its largest energy, with the contact that brought
     most of it)."""
-    stressing = [e for e in events if e["kind"] in ("damage", "breakage")]
+    stressing = [e for e in events if e["kind"] in ("damage", "breakage", "stressing")]
     energies = np.array([e["specific_energy"] for e in stressing])
     positive = energies[energies > 0]
     low, high = ((positive.min(), positive.max()) if len(positive) else (1e-3, 1.0))
@@ -216,7 +216,8 @@ def collision_spectra(events, info, duration):
 def _options(args, out):
     read_period = read_period_value(args.read_period)
     options = dict(time_step_fraction=args.time_step_fraction, dummies="ledger",
-                   read_period=read_period, event_log=str(out / "events.jsonl"))
+                   read_period=read_period, event_log=str(out / "events.jsonl"),
+                   breakage=bool(getattr(args, "breakage", True)))
     options["dmin"] = args.dmin if args.dmin > 0 else args.size / 3.0
     return options
 
@@ -377,6 +378,8 @@ def _report(brk, info, loop, args, out, runtime, end_reason, end_message):
         "bodies_end": sum(1 for b in O.bodies if b is not None),
         "breakage_events": sum(e["kind"] == "breakage" for e in events),
         "damage_events": sum(e["kind"] == "damage" for e in events),
+        "breakage": bool(getattr(args, "breakage", True)),
+        "stressing_events": sum(e["kind"] == "stressing" for e in events),
         "initial_mass": ore_mass, "final_mass": brk.total_mass(),
         "mass_relative_error": abs(brk.total_mass() - ore_mass) / ore_mass,
         "broken_mass": broken, "broken_mass_fraction": broken / ore_mass,
@@ -415,8 +418,18 @@ def _report(brk, info, loop, args, out, runtime, end_reason, end_message):
                 w.writerow([edges[k], edges[k + 1]] + [float(v) for kind in PAIR_TYPES
                                                        for v in (spectra[kind][0][k],
                                                                  spectra[kind][1][k])])
+        if not summary["breakage"]:            # the spectra run: the grinding model's input
+            _write_grinding_spectra(out)
     _plots(out, summary, loop, info, power, edges, spectra)
     return summary
+
+
+def _write_grinding_spectra(out):
+    """spectra.csv for `python3 -m yadebreak grind` (docs/grinding.md, Section 2), from this
+    run's summary.json and collision_spectra.csv."""
+    from yadebreak.tools.grinding.cli import SPECTRA_NAME
+    from yadebreak.tools.grinding.spectra import from_mill_run, write_spectra
+    write_spectra(out / SPECTRA_NAME, from_mill_run(out))
 
 
 def _plots(out, summary, loop, info, power, edges, spectra):
