@@ -29,7 +29,6 @@ import time
 import zipfile
 from dataclasses import dataclass, field
 from functools import lru_cache
-from pathlib import Path
 
 import numpy as np
 from scipy.optimize import linprog

@@ -3,18 +3,14 @@ lattice or poured and settled (poured_bed). YADE layer."""
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
-from pathlib import Path
 
 import numpy as np
 
-from yadebreak.model import placement
-from yadebreak.coupling import add_materials, attach, run_steps
-from yadebreak.coupling.rolling import rolling_engine
+from yadebreak.coupling import add_materials, attach
 from yadebreak.coupling.scene_materials import rolling_friction
-from yadebreak.coupling.yade_api import O, geom, utils, wrapper as _w
-from .impacts import hertz_engines, scene_seed
+from yadebreak.coupling.yade_api import O, geom, utils
+from .impacts import hertz_engines
 
 
 BALL_DIAMETER = 0.088          # m, the paper's steel ball

@@ -2,7 +2,6 @@
 the Hertz-Mindlin engine list every scene shares. YADE layer."""
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 from pathlib import Path
@@ -13,7 +12,6 @@ import numpy as np
 from yadebreak.model import placement
 from yadebreak.coupling import add_materials, attach, run_steps
 from yadebreak.coupling.rolling import rolling_engine
-from yadebreak.coupling.scene_materials import rolling_friction
 from yadebreak.coupling.yade_api import O, utils, wrapper as _w
 from yadebreak.tools.lifecycle import stop_point, stop_points
 

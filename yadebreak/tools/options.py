@@ -369,7 +369,10 @@ def script_params(params, description=None, argv=None, table_row=None):
     params = [p for p in params if p.name != "debug"] + [DEBUG]
     _SCRIPT_OPTIONS.clear()
     _SCRIPT_OPTIONS.update(p.name for p in params)
-    if os.environ.get("YADE_BATCH") and table_row is not None:
+    if os.environ.get("YADE_BATCH"):
+        if table_row is None:         # reading argv would ignore the table's row
+            fail("under yade-batch the options come from the table's row: pass "
+                 "table_row=yadebreak.coupling.yade_api.table_row to script_params")
         defaults = {p.name: p.default for p in params}
         row, description = table_row(defaults)
         values = argparse.Namespace(**row)
