@@ -12,12 +12,12 @@ OUT ?= out
 # LINK_PACKAGE.
 deps:
 	@if ! command -v yade >/dev/null 2>&1 || ! $(PY) -c "import pytest, numpy, scipy, matplotlib, \
-		dask, distributed; from yadebreak.coupling.yadepath import ensure_yade_importable as ok; \
+		dask, distributed, xdist; from yadebreak.coupling.yadepath import ensure_yade_importable as ok; \
 		assert ok()" >/dev/null 2>&1; then \
 		echo "[yadebreak] installing YADE and Python packages from Debian (a few minutes, once)"; \
 		apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q \
 			yade python3-yade python3-pytest python3-numpy python3-scipy python3-matplotlib \
-			python3-dask python3-distributed; \
+			python3-dask python3-distributed python3-pytest-xdist; \
 	fi
 	@$(PY) -c "$$LINK_PACKAGE" "$(CURDIR)"
 
@@ -44,7 +44,7 @@ model-demo:
 	$(PY) -m yadebreak demo --out $(OUT)/model_demo
 
 test: deps
-	$(PY) -m pytest -q tests
+	$(PY) -m pytest -q -n auto tests
 
 # The pure model tests need only numpy, scipy and pytest (no YADE).
 test-model:

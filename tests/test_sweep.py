@@ -158,6 +158,12 @@ def test_a_line_gives_what_yade_batch_gives(tmp_path):
     assert ours == theirs
 
 
+def _ctrl_c_as_in_a_terminal():
+    """SIGINT back to its default in the child: a parent that ignores it (pytest-xdist's workers
+    do) would otherwise hand the sweep an ignored Ctrl-C, as nohup does on purpose."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.yade
 def test_a_killed_sweep_resumes_keeping_the_lines_done(tmp_path):
     pytest.importorskip("distributed")
@@ -166,7 +172,8 @@ def test_a_killed_sweep_resumes_keeping_the_lines_done(tmp_path):
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "yadebreak", "sweep", str(table), str(SCRIPT),
                              "--out", str(out), "--scheduler", "local:1"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT,
+                            preexec_fn=_ctrl_c_as_in_a_terminal)
     status_file = out / "sweep.json"
     deadline = time.time() + 300
     while time.time() < deadline:

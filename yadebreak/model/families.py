@@ -322,7 +322,7 @@ def _table_cached(beta_key, t10_min, t10_max, seed):
         for i, fs in enumerate(table.sets):
             arrays[f"counts{i}"] = fs.counts
             arrays[f"prob{i}"] = fs.probabilities
-        tmp = path.with_suffix(".tmp.npz")
+        tmp = path.with_name(f"{path.stem}.{os.getpid()}.tmp.npz")  # processes may race
         np.savez(tmp, **arrays)
         os.replace(tmp, path)
     except OSError:
