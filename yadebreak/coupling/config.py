@@ -117,10 +117,13 @@ OPTIONS = (
            "(0, 1] or None", "-",
            "O.dt at most this fraction of the smallest sphere's Rayleigh time (a smaller O.dt set "
            "before attach is kept); None leaves O.dt to the user"),
-    Option("global_damping", "time_step", 0.0, _number(0, 1, hi_open=True), "[0, 1)", "-",
-           "Newton damping applied to fresh fragments only"),
-    Option("global_damping_time", "time_step", 0.0, _number(0), ">= 0", "s",
-           "how long fresh fragments stay damped"),
+    Option("global_damping", "time_step", None, _number(0, 1, hi_open=True, none=True),
+           "[0, 1) or None", "-",
+           "the paper's global damping of fragments: a force against each fragment's motion of "
+           "this share of the force on it (YADE's Newton damping on fragments only; the parent "
+           "never); None: each material file's global_damping (0.3 copper ore, else 0)"),
+    Option("global_damping_time", "time_step", None, _number(0, none=True), ">= 0 or None", "s",
+           "how long fresh fragments stay damped; None: for as long as they exist"),
     # output
     Option("event_log", "output", None, _path_or_none, "a path or None", "-",
            "JSON-lines file that receives every event as it happens"),
@@ -162,8 +165,8 @@ class Replacement:
 @dataclass(frozen=True)
 class TimeStep:
     time_step_fraction: float | None
-    global_damping: float
-    global_damping_time: float
+    global_damping: float | None
+    global_damping_time: float | None
 
 
 @dataclass(frozen=True)

@@ -78,14 +78,16 @@ class Controller:
         self.schedule = ReadSchedule(config.reading, label, self._smallest_breakable,
                                      self._low_fracture_energy)
         self.time_step = TimeStep(config.time_step.time_step_fraction, self._warn_once)
-        self.damping = FragmentDamping(config.time_step.global_damping,
-                                       config.time_step.global_damping_time)
+        gd = config.time_step.global_damping        # None: each material file's
+        self.damping = FragmentDamping(
+            {lab: (gd if gd is not None else mat.global_damping)
+             for lab, mat in self.material.items()}, config.time_step.global_damping_time)
         tables = {lab: families.table_for(mat, config.replacement.family_seed)
                   for lab, mat in self.material.items()}
         self.replacer = Replacer(config.replacement, self.state.table, self.state.rng,
                                  self.criteria, tables, self.zeroing, self.reader,
                                  self.state.ledger, self.pause_steps,
-                                 config.time_step.global_damping > 0.0)
+                                 self.damping.damped_labels)
         self.judge = Judge(self.state, self._criterion_of, self.reader,
                            config.criteria.fragments_energy_factor,
                            any(self.pause_steps.values()), config.reading.fast_tolerance,

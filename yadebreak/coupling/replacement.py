@@ -68,8 +68,10 @@ def _sphere_body(material, center, radius, mass, vel, angvel, damped):
     state.inertia = (inertia, inertia, inertia)
     state.vel = vel
     state.angVel = angvel
-    if damped:
-        state.isDamped = True          # global damping acts on fresh fragments only
+    if damped is not None:
+        # global damping acts on fragments of damped materials only (without any, YADE's
+        # default is left as it always was)
+        state.isDamped = damped
     return b
 
 
@@ -87,7 +89,7 @@ class Replacer:
         self.reader = reader           # told which contacts the fragments inherit
         self.ledger = ledger
         self.pause_steps = pause_steps  # material label -> steps
-        self.damped = damped           # fragments start damped (global damping)
+        self.damped = damped           # labels whose fragments start damped (global damping)
 
     def replace(self, bid, t10, direction, dmin):
         """Erase body `bid` and insert its progeny for t10' (%), coarse fragments across
@@ -123,7 +125,7 @@ class Replacer:
         kinetic_after = 0.5 * float(masses @ (vel * vel).sum(axis=1)
                                     + inertias.sum() * spin @ spin)
         radii, centers, masses, vel = radii[keep], centers[keep], masses[keep], vel[keep]
-        new = [_sphere_body(material, c, r, m, v, spin, self.damped)
+        new = [_sphere_body(material, c, r, m, v, spin, (label in self.damped) if self.damped else None)
                for c, r, m, v in zip(centers.tolist(), radii.tolist(), masses.tolist(),
                                      vel.tolist())]
         ids = list(O.bodies.append(new))

@@ -6,6 +6,7 @@ import heapq
 import math
 
 from yadebreak.model import placement
+from .config import AttachError
 from .yade_api import O, find_engine, utils, wrapper
 
 #: read_period="fast" never waits longer than this many steps between reads.
@@ -239,11 +240,32 @@ class TimeStep:
 
 
 class FragmentDamping:
-    """Global damping on fresh fragments only, for global_damping_time seconds."""
+    """The paper's global damping: fragments only, from their creation, for global_damping_time
+    seconds (None: as long as they exist). Each material has its strength (its file's
+    global_damping, or attach's global_damping for all).
 
-    def __init__(self, strength, duration):
-        self.strength = strength
-        self.duration = duration
+    It is YADE's Newton (Cundall) damping, switched on for fragments only through
+    state.isDamped: on a damped body each component of the force (and torque) is reduced by the
+    strength times its magnitude when it speeds the body up and increased likewise when it slows
+    it down, i.e. a force of `strength` times the force on the body, always against the body's
+    motion (the EDEM manual's "percentage of total contact force upon the particle"). It is never
+    on the parent or any body that existed at attach, so the contacts that stress an intact
+    particle (the impact, Eqs. 1-6) are untouched; it only takes kinetic energy from fragments
+    (its power -strength sum |F_i v_i| <= 0), in C++ every step at no cost in Python. Newton has
+    one damping value per scene: materials with different non-zero strengths in one scene are
+    refused (attach's global_damping sets one for all). docs/high_energy.md, "Global damping"."""
+
+    def __init__(self, strengths, duration):
+        self.strengths = dict(strengths)      # material label -> strength in [0, 1)
+        self.duration = duration              # s, or None: for the fragment's life
+        nonzero = sorted({v for v in self.strengths.values() if v > 0.0})
+        if len(nonzero) > 1:
+            raise AttachError(
+                f"global_damping: the materials' files give {nonzero} (by label: "
+                f"{self.strengths}) but YADE's Newton damping is one value per scene: pass "
+                f"global_damping (in [0, 1)) to attach() for all")
+        self.strength = nonzero[0] if nonzero else 0.0
+        self.damped_labels = {lab for lab, v in self.strengths.items() if v > 0.0}
         self.until = []                       # [time (s), [ids]]
 
     def apply_at_attach(self):
@@ -251,14 +273,16 @@ class FragmentDamping:
         if self.strength <= 0.0:
             return
         newton = next((e for e in O.engines if isinstance(e, wrapper.NewtonIntegrator)), None)
-        if newton is not None:
-            newton.damping = self.strength
-            for b in O.bodies:
-                if b is not None:
-                    b.state.isDamped = False
+        if newton is None:
+            raise AttachError(f"global_damping = {self.strength:g}: the scene has no "
+                              f"NewtonIntegrator to apply it; add one or set global_damping=0")
+        newton.damping = self.strength
+        for b in O.bodies:
+            if b is not None:
+                b.state.isDamped = False
 
     def add(self, ids):
-        if self.strength > 0.0:
+        if self.strength > 0.0 and self.duration is not None:
             self.until.append((O.time + self.duration, list(ids)))
 
     def release(self):
@@ -269,7 +293,7 @@ class FragmentDamping:
         for until, ids in self.until:
             if now >= until:
                 for i in ids:
-                    b = O.bodies[i]
+                    b = O.bodies[i] if i < len(O.bodies) else None
                     if b is not None:
                         b.state.isDamped = False
             else:

@@ -72,6 +72,9 @@ class Material:
     A: float | None = None
     b_prime: float | None = None
     kappa: float | None = None
+    #: the paper's global damping of fresh fragments (0.3 for copper ore, 0 otherwise); attach's
+    #: global_damping overrides it (docs/high_energy.md, "Global damping")
+    global_damping: float = 0.0
     device_stiffness: float = model.DEVICE_STIFFNESS_STEEL
     beta_params: Mapping[float, tuple] | None = None
     beta_source: str | None = None
@@ -229,6 +232,8 @@ _AB_T10 = [
     ("selection", 0.0, False, math.inf, False, "kg/J", 1.0),
     ("t10_max", 0.0, False, 100.0, True, "%", 1.0),
 ]
+#: optional for every breakage model: the damping of fresh fragments (docs/high_energy.md)
+_GLOBAL_DAMPING = ("global_damping", 0.0, True, 1.0, False, "-", 1.0)
 #: Ab-T10 events with t10 below this (%) take the family set at this t10 (see Material.t10_min):
 #: below it the 11 classes cannot follow Eq. 10 within 2 % (2.6 % at t10 = 1 %).
 AB_T10_T10_FLOOR = 2.0
@@ -247,7 +252,8 @@ class TavaresCriterion:
 
     name = "tavares"
     #: [breakage] keys of the file (see _parse_breakage) and the defaults of the optional ones
-    keys, defaults = _TAVARES, {"emax_ratio": 100.0, "kappa": 1.0}
+    keys, defaults = _TAVARES + [_GLOBAL_DAMPING], {"emax_ratio": 100.0, "kappa": 1.0,
+                                                        "global_damping": 0.0}
     #: the plots' legends of the model's breakage probability and t10
     probability_label = "model (Eqs. 1-4)"
     t10_label = "model: Eq. 7, e Ek/mp over E50b of the broken particles"
@@ -338,7 +344,7 @@ class AbT10Criterion:
     see TavaresCriterion."""
 
     name = "ab_t10"
-    keys, defaults = _AB_T10, {}
+    keys, defaults = _AB_T10 + [_GLOBAL_DAMPING], {"global_damping": 0.0}
     probability_label = "model P(e_cum), e_cum = e Ek/mp - e_min (Eqs. 4, 9.1-9.3)"
     t10_label = "model: Eq. 9.4"
 
