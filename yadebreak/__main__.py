@@ -258,6 +258,9 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["tradeoff"]:
         return tradeoff_command(argv[1:])
+    if argv[:1] == ["verify"]:             # runs YADE in this process: imported only here
+        from yadebreak.runs.verify import main as verify_main
+        return verify_main(argv[1:])
     if argv[:1] == ["fit"]:                # DATA... takes several files: its own parser
         from yadebreak.tools.calibration.cli import main as fit_main
         return fit_main(argv[1:])
@@ -267,6 +270,8 @@ def main(argv=None):
                    "(python -m yadebreak tradeoff --help)")     # parsed by tradeoff_command
     sub.add_parser("fit", help="a material file from laboratory data, with 95 %% intervals "
                    "(python -m yadebreak fit --help; docs/calibration.md)")
+    sub.add_parser("verify", help="the paper's Section 4.1 figures at its settings, a report "
+                   "with plots (python -m yadebreak verify --help; --quick 1: under 3 minutes)")
     for name, (func, what, params, *positional) in COMMANDS.items():
         p = sub.add_parser(name, help=what, description=what)
         for arg, arg_help in (positional[0] if positional else ()):
