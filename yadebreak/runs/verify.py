@@ -123,6 +123,12 @@ class Runner:
                     run.per_scene, run.seed, target=run.target, jobs=self.jobs,
                     wait_for_arrivals=True, **run.options)
                 result = reports.breakage_result_of(tally, mat, energy, steel)
+                if run.options.get("replace") is False:      # no progeny: no t10 to show
+                    for key in ("t10_simulated", "t10_primary_events", "progeny_markers",
+                                "relative_sizes", "progeny_passing_simulated",
+                                "progeny_passing_model"):
+                        result.pop(key, None)
+                    result["t10_note"] = "broken particles not replaced (probability only)"
                 result.update(steps=tally.steps, scenes_at_step_limit=tally.scenes_at_step_limit,
                               wall_s=time.time() - began, material=mat.name, size=run.size,
                               options=run.options, seed=run.seed)
