@@ -1,5 +1,6 @@
 """Command line: `python -m yadebreak demo | families | materials | options | sweep | gather |
-tradeoff | fit | grind` (no YADE needed here; the workers of a sweep or a trade-off run YADE).
+tradeoff | fit | grind | verify` (no YADE needed here but for verify, which runs YADE in its
+process; the workers of a sweep or a trade-off run YADE).
 
 Options are declared as the scripts' are (scriptargs: type, range, unit, default, help); a bad
 value stops with one line naming the option, the value, the range and the unit (exit code 2)."""
