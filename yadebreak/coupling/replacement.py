@@ -125,7 +125,8 @@ class Replacer:
         kinetic_after = 0.5 * float(masses @ (vel * vel).sum(axis=1)
                                     + inertias.sum() * spin @ spin)
         radii, centers, masses, vel = radii[keep], centers[keep], masses[keep], vel[keep]
-        new = [_sphere_body(material, c, r, m, v, spin, (label in self.damped) if self.damped else None)
+        damped = (label in self.damped) if self.damped else None
+        new = [_sphere_body(material, c, r, m, v, spin, damped)
                for c, r, m, v in zip(centers.tolist(), radii.tolist(), masses.tolist(),
                                      vel.tolist())]
         ids = list(O.bodies.append(new))

@@ -83,13 +83,16 @@ class ImpactTally:
     first: each fired particle's first event (the impact itself; none for a particle with no
     event); e_cum_intact: Ab-T10's e_cum (J/kg) of the particles that did not break;
     progeny_mass and marker_mass: mass (kg) passing size x RELATIVE_SIEVES and size / MARKERS
-    (every fragment, fines included); masses (kg) of the scenes at their start and end."""
+    (every fragment, fines included); resolved_mass: passing size x RELATIVE_SIEVES counting the
+    spheres in the scene as they are (no fines: the paper's Fig. 13); masses (kg) of the scenes at
+    their start and end."""
     size: float
     particles: int = 0
     first: list = field(default_factory=list)
     e_cum_intact: list = field(default_factory=list)
     progeny_mass: np.ndarray = None
     marker_mass: np.ndarray = None
+    resolved_mass: np.ndarray = None
     breakage_events: int = 0
     initial_mass: float = 0.0
     final_mass: float = 0.0
@@ -101,6 +104,8 @@ class ImpactTally:
         if self.progeny_mass is None:
             self.progeny_mass = np.zeros(len(RELATIVE_SIEVES))
             self.marker_mass = np.zeros(len(MARKERS))
+        if self.resolved_mass is None:
+            self.resolved_mass = np.zeros(len(RELATIVE_SIEVES))
 
     def add(self, brk, ids, initial_mass):
         """Add the scene of controller `brk`, whose fired particles are `ids` and whose mass was
@@ -114,6 +119,8 @@ class ImpactTally:
         if broken:
             self.progeny_mass += brk.size_distribution(self.size * RELATIVE_SIEVES).passing_mass
             self.marker_mass += brk.size_distribution(self.size / np.array(MARKERS)).passing_mass
+            self.resolved_mass += brk.size_distribution(self.size * RELATIVE_SIEVES,
+                                                        fines=False).passing_mass
         self.breakage_events += len(brk.breakage_events)
         self.initial_mass += initial_mass
         self.final_mass += brk.total_mass()
@@ -128,18 +135,22 @@ class ImpactTally:
         self.e_cum_intact += other.e_cum_intact
         self.progeny_mass = self.progeny_mass + other.progeny_mass
         self.marker_mass = self.marker_mass + other.marker_mass
+        self.resolved_mass = self.resolved_mass + other.resolved_mass
 
     def to_dict(self):
         """Plain JSON types (a worker process hands its tally over in a file)."""
         out = {k: getattr(self, k) for k in self.__dataclass_fields__}
         out.update(progeny_mass=self.progeny_mass.tolist(), marker_mass=self.marker_mass.tolist(),
+                   resolved_mass=self.resolved_mass.tolist(),
                    e_cum_intact=[float(e) for e in self.e_cum_intact])
         return out
 
     @classmethod
     def from_dict(cls, data):
+        resolved = data.get("resolved_mass")       # absent in tallies written before it
         return cls(**{**data, "progeny_mass": np.array(data["progeny_mass"]),
-                      "marker_mass": np.array(data["marker_mass"])})
+                      "marker_mass": np.array(data["marker_mass"]),
+                      "resolved_mass": None if resolved is None else np.array(resolved)})
 
     @property
     def broken(self):
@@ -190,6 +201,7 @@ def breakage_result_of(tally, material, specific_energy, partner):
                             for n, sim in zip(MARKERS, markers)},
         "relative_sizes": RELATIVE_SIEVES.tolist(),
         "progeny_passing_simulated": passing.tolist(),
+        "progeny_passing_resolved": (100 * tally.resolved_mass / parent_mass).tolist(),
         "progeny_passing_model": (model.progeny_passing(t10_model, material.beta_params,
                                                         RELATIVE_SIEVES).tolist()
                                   if np.isfinite(t10_model) else None)})

@@ -1,0 +1,148 @@
+"""The paper's single-particle settings (its Section 3), one set of impacts (`Run`) and the runner
+that runs each set once however many figures share it."""
+from __future__ import annotations
+
+import dataclasses
+import json
+import time
+
+import numpy as np
+
+from yadebreak.model.materials import load_material
+from yadebreak.model import reports
+from yadebreak.tools.lifecycle import progress
+
+#: the paper's single-particle verification (its Section 3)
+EMAX_RATIO = 4.0
+PROBABILITY_SIZE = 5.5e-3
+FRAGMENT_SIZE = 29e-3
+RT_PROBABILITY, RT_FRAGMENTATION, RT_DAMPING = 0.05, 0.02, 0.01
+PAPER_MATERIALS = ("copper_ore", "granulite", "limestone")
+#: the model probabilities at which Figs. 8-10 are sampled
+PROBABILITY_LEVELS = (0.1, 0.3, 0.5, 0.7, 0.9)
+QUICK_LEVELS = (0.2, 0.5, 0.8)
+
+@dataclasses.dataclass
+class Run:
+    """One set of impacts: `particles` particles of `material` (name) and `size` (m) at each
+    energy, with attach() options; `test` "single" (fired at the target) or "drop_weight" (a
+    steel striker 50 times the particle's mass falls on it on a steel anvil: the paper's DWT)."""
+
+    material: str
+    size: float
+    energies: list
+    particles: int
+    seed: int
+    options: dict
+    per_scene: int = 1
+    target: str = "steel"
+    test: str = "single"
+
+    def key(self, energy):
+        return json.dumps([self.material, self.size, energy, self.particles, self.seed,
+                           self.target, self.test, sorted(self.options.items())])
+
+
+def paper_material(name):
+    """The material as the paper's single-particle verification ran it (Emax/E50 = 4)."""
+    return dataclasses.replace(load_material(name), emax_ratio=EMAX_RATIO)
+
+
+def probability_energies(material, size, levels, partner):
+    """Specific energies (J/kg, rounded to 2 digits) at which the model's probability is each of
+    `levels`."""
+    grid = np.geomspace(1.0, 1e5, 4000)
+    p = material.breakage_probability(grid, size, partner=partner)
+    return [float(f"{np.interp(level, p, grid):.2g}") for level in levels]
+
+
+def paper_options(time_step, **more):
+    """attach() options of the paper's settings at `time_step` (fraction of the Rayleigh time),
+    contacts read at every step unless `more` says otherwise."""
+    return {"time_step_fraction": time_step, "emax_ratio": EMAX_RATIO, "kappa": 1.0, "cs": 0.0,
+            "emin": 1e-4, "dmin": None, "read_period": "every_step", **more}
+
+
+class Runner:
+    """Runs impacts once per key (figures share runs) and keeps every result."""
+
+    def __init__(self, jobs):
+        self.jobs = jobs
+        self.results = {}
+        self.wall = {}
+
+    def run(self, run):
+        from yadebreak import scenes
+        mat, steel = paper_material(run.material), load_material(run.target)
+        out = []
+        for energy in run.energies:
+            key = run.key(energy)
+            if key not in self.results:
+                began = time.time()
+                if run.test == "drop_weight":
+                    tally = drop_weight_tally(run, energy)
+                else:
+                    tally, _ = scenes.single_impacts(
+                        run.material, run.size, float(np.sqrt(2.0 * energy)), run.particles,
+                        run.per_scene, run.seed, target=run.target, jobs=self.jobs,
+                        wait_for_arrivals=True, **run.options)
+                result = reports.breakage_result_of(tally, mat, energy, steel)
+                if run.options.get("replace") is False:      # no progeny: no t10 to show
+                    for name in ("t10_simulated", "t10_primary_events", "progeny_markers",
+                                 "relative_sizes", "progeny_passing_simulated",
+                                 "progeny_passing_model"):
+                        result.pop(name, None)
+                    result["t10_note"] = "broken particles not replaced (probability only)"
+                result.update(steps=tally.steps, scenes_at_step_limit=tally.scenes_at_step_limit,
+                              wall_s=time.time() - began, material=mat.name, size=run.size,
+                              options=run.options, seed=run.seed, test=run.test)
+                self.results[key] = result
+                progress(f"{mat.name} {1e3 * run.size:g} mm {run.test} "
+                         f"{_settings_short(run.options)}: "
+                         f"{reports.result_line(result)} ({result['wall_s']:.0f} s)")
+            out.append(self.results[key])
+        return out
+
+
+#: simulated time after which a drop-weight scene stops even if a striker still falls (s)
+DROP_WEIGHT_MAX_TIME = 0.05
+
+
+def drop_weight_tally(run, energy):
+    """The drop-weight tests of `run` at `energy` (J/kg) in one scene (the strikers side by side),
+    run to their end (scenes.run_drop_weight): a reports.ImpactTally."""
+    from yadebreak import scenes
+    brk, ids, strikers = scenes.drop_weight_scene(run.material, run.size, energy, run.particles,
+                                                  seed=run.seed, **run.options)
+    tally = reports.ImpactTally(run.size)
+    initial_mass = brk.total_mass()
+    tally.steps, limited = scenes.run_drop_weight(brk, ids, strikers, DROP_WEIGHT_MAX_TIME)
+    tally.scenes_at_step_limit = int(limited)
+    brk.finish()
+    tally.add(brk, ids, initial_mass)
+    return tally
+
+
+def _settings_short(options):
+    gd = options.get("global_damping")
+    return (f"dt {100 * options['time_step_fraction']:g} % RT, global damping "
+            f"{'file' if gd is None else f'{gd:g}'}")
+
+
+def settings_text(options, material_names, size, particles, seed, extra="", damping=None,
+                  target="steel"):
+    """One line of a figure's settings; `damping` (text) replaces the files' global damping;
+    `size` in m or a text (several sizes), `target` the text after "on"."""
+    gd = options.get("global_damping")
+    if damping is None:
+        damping = ("each material file's (" + ", ".join(
+            f"{n} {load_material(n).global_damping:g}" for n in material_names) + ")"
+                   if gd is None else f"{gd:g}")
+    size = size if isinstance(size, str) else f"{1e3 * size:g} mm"
+    return (f"{size} on {target}, {particles} particles per point, seed {seed}; "
+            f"Emax/E50 {EMAX_RATIO:g}, time step {100 * options['time_step_fraction']:g} % of "
+            f"the Rayleigh time, dmin = top size / 20, emin 1e-4 J, kappa 1, "
+            f"cs {options.get('cs', 0.0):g}, global damping {damping}, contacts read "
+            f"{'every step' if options['read_period'] == 'every_step' else 'in fast mode'}"
+            + ("" if options.get("replace", True) else ", broken particles not replaced")
+            + (f"; {extra}" if extra else ""))
