@@ -201,11 +201,17 @@ def breakage_result_of(tally, material, specific_energy, partner):
                             for n, sim in zip(MARKERS, markers)},
         "relative_sizes": RELATIVE_SIEVES.tolist(),
         "progeny_passing_simulated": passing.tolist(),
-        "progeny_passing_resolved": (100 * tally.resolved_mass / parent_mass).tolist(),
         "progeny_passing_model": (model.progeny_passing(t10_model, material.beta_params,
                                                         RELATIVE_SIEVES).tolist()
                                   if np.isfinite(t10_model) else None)})
     return result
+
+
+def resolved_progeny_passing(tally):
+    """Passing (%) of the broken particles' progeny at tally.size x RELATIVE_SIEVES counting the
+    spheres as they stand in the scene (no fines: the paper's Fig. 13); None if none broke."""
+    parent_mass = sum(e["mass"] for e in tally.broken)
+    return (100 * tally.resolved_mass / parent_mass).tolist() if parent_mass else None
 
 
 def check_breakage_result(result, material, size, specific_energy, partner, particles):
