@@ -273,3 +273,23 @@ def test_docs_options_is_the_table_as_rendered_now():
     with contextlib.redirect_stdout(out):
         main(["options"])
     assert (Path(__file__).resolve().parent.parent / "docs" / "options.md").read_text() == out.getvalue()
+
+
+def test_kappa_successive_sets_eq8_for_fragments_only():
+    """kappa_successive is Eq. 8's kappa for bodies of generation >= 1; the parent (generation 0)
+    keeps the material's kappa, and None keeps it for every generation."""
+    cu = load_material("copper_ore")
+    table = BodyTable(["ore"])
+    table.add([0, 1], BREAKABLE, "ore", mass=2e-3, radius=5e-3, fracture_energy=400.0,
+              generation=np.array([0, 1]))
+    ek = 1.7 * 2e-3 * 400.0                        # J: the ratio of Eq. 8 is 1.7 for both
+    paper, successive = criteria.Tavares(cu), criteria.Tavares(cu, kappa_successive=0.5)
+    for crit, kappas in ((paper, (cu.kappa, cu.kappa)), (successive, (cu.kappa, 0.5))):
+        for i, kappa in zip((0, 1), kappas):
+            ratio, t10, _ = crit.breakage(table, i, ek)
+            assert ratio == pytest.approx(1.7)
+            assert t10 == pytest.approx(cu.A * (1 - math.exp(-cu.b_prime * 1.7 / kappa)))
+    cfg = config.Config.from_options(kappa_successive=0.5)
+    assert cfg.criteria.kappa_successive == 0.5
+    with pytest.raises(config.AttachError, match="kappa_successive"):
+        config.Config.from_options(kappa_successive=0.0)

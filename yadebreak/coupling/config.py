@@ -85,6 +85,10 @@ OPTIONS = (
     # criteria: overrides of the material files and Rocky's safeguards
     Option("kappa", "criteria", None, _number(0, lo_open=True, none=True), "> 0 or None", "-",
            "overrides the material's kappa (Eq. 8); None keeps the file's"),
+    Option("kappa_successive", "criteria", None, _number(0, lo_open=True, none=True),
+           "> 0 or None", "-",
+           "kappa of Eq. 8 for the breakage of fragments (generation >= 1; Tavares materials); "
+           "None: the same as the first breakage's (the paper's)"),
     Option("emax_ratio", "criteria", None, _number(1, lo_open=True, none=True), "> 1 or None", "-",
            "overrides the material's Emax/E50 (Eq. 2); None keeps the file's"),
     Option("pause_steps", "criteria", None, _count(0, none=True), "an integer >= 0 or None",
@@ -145,6 +149,7 @@ class Reading:
 @dataclass(frozen=True)
 class Criteria:
     kappa: float | None
+    kappa_successive: float | None
     emax_ratio: float | None
     pause_steps: int | None
     breakage: bool

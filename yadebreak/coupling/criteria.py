@@ -57,8 +57,10 @@ class Tavares:
     #: unload()'s events are damage events
     event_kind = "damage"
 
-    def __init__(self, material):
+    def __init__(self, material, kappa_successive=None):
         self.material = material
+        # Eq. 8's kappa for fragments (generation >= 1); None: the material's for every event
+        self.kappa_successive = kappa_successive
 
     def overridden(self, kappa=None, emax_ratio=None):
         """The material with attach()'s overrides of kappa (Eq. 8) and Emax/E50 (Eq. 2)."""
@@ -94,9 +96,11 @@ class Tavares:
         return {"fracture_energy": before, "fracture_energy_after": after, "ratio": ratio}
 
     def breakage(self, table, i, ek):
-        mat = self.material
-        ratio = ek / (float(table.columns["mass"][i]) * float(table.columns["fracture_energy"][i]))
-        return ratio, float(model.t10(ratio, mat.A, mat.b_prime, mat.kappa)), {}
+        mat, c = self.material, table.columns
+        ratio = ek / (float(c["mass"][i]) * float(c["fracture_energy"][i]))
+        kappa = (mat.kappa if self.kappa_successive is None or c["generation"][i] == 0
+                 else self.kappa_successive)
+        return ratio, float(model.t10(ratio, mat.A, mat.b_prime, kappa)), {}
 
     def force(self, table, i, ratio):
         return ratio * float(table.columns["mass"][i]) * float(table.columns["fracture_energy"][i])
@@ -243,9 +247,11 @@ class Recording:
 _CRITERIA = {"tavares": Tavares, "ab_t10": AbT10}
 
 
-def criterion_for(material, breakage=True):
+def criterion_for(material, breakage=True, kappa_successive=None):
     """The criterion object of a breakable Material: the counterpart of the one its model
-    names (Material.criterion); with breakage=False its Recording."""
-    criterion = _CRITERIA[material.criterion.name](material)
+    names (Material.criterion); with breakage=False its Recording. kappa_successive: Eq. 8's
+    kappa for fragments (Tavares materials; None: the material's)."""
+    criterion = (Tavares(material, kappa_successive) if material.criterion.name == "tavares"
+                 else _CRITERIA[material.criterion.name](material))
     return criterion if breakage else Recording(criterion)
 

@@ -83,6 +83,8 @@ PARAMS = [
     text("read_period", "fast", "how Figs. 13-19 read contacts: fast (the engine's default; "
          "the same t10 as every_step within 1 %, up to 2.4x faster on limestone's fragment "
          "clouds: docs/high_energy.md) or every_step (exact); Figs. 8-11 read every step"),
+    number("kappa_successive", 0.0, "-", "Eq. 8's kappa for the fragments' breakage in Figs. "
+           "13-19 (an option beyond the paper; 0: the paper's, the parent's kappa 1)", lo=0),
     integer("jobs", 1, "YADE processes sharing each run's scenes", lo=1, unit="processes"),
     text("out", "out/verify", "output folder"),
 ]

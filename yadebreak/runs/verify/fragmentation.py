@@ -32,8 +32,10 @@ FAMILY_FLOOR, DMIN_RELATIVE = float(CLASS_SIZES[-1]), 1.0 / 20.0
 
 
 def _options(args, time_step, **more):
-    """The paper's settings, contacts read as --read-period says."""
-    return paper_options(time_step, read_period=args.read_period, **more)
+    """The paper's settings, contacts read as --read-period says (and --kappa-successive, an
+    option beyond the paper, when given)."""
+    beyond = {"kappa_successive": args.kappa_successive} if args.kappa_successive else {}
+    return paper_options(time_step, read_period=args.read_period, **beyond, **more)
 
 
 def _particles(args):

@@ -146,4 +146,6 @@ def settings_text(options, material_names, size, particles, seed, extra="", damp
             f"cs {options.get('cs', 0.0):g}, global damping {damping}, contacts read "
             f"{'every step' if options['read_period'] == 'every_step' else 'in fast mode'}"
             + ("" if options.get("replace", True) else ", broken particles not replaced")
+            + (f"; beyond the paper: kappa {options['kappa_successive']:g} for fragments"
+               if options.get("kappa_successive") else "")
             + (f"; {extra}" if extra else ""))
