@@ -2,9 +2,9 @@
 settings, as a Markdown report with one plot per figure (model lines and simulated points side by
 side, each figure's settings printed under it).
 
-The paper's settings (its Section 3; docs/high_energy.md): Emax/E50 = 4 in every single-particle
-run; 5 % of the Rayleigh time (RT) for the probabilities, 2 % for the fragmentation, 1 % in the
-damping study (its Fig. 19 caption); dmin = top size / 20, emin = 1e-4 J, kappa = 1, cs = 0;
+The paper's settings (its Section 3; docs/verification.md): Emax/E50 = 4 in every
+single-particle run; 5 % of the Rayleigh time (RT) for the probabilities, 2 % for the
+fragmentation, 1 % in the cs and damping studies (its Figs. 18-19 captions); dmin = top size / 20, emin = 1e-4 J, kappa = 1, cs = 0;
 global damping from each material file (0.3 copper ore, 0 otherwise); 5.5 mm particles for the
 probabilities, 29 mm for the size distributions and t10.
 
@@ -33,9 +33,10 @@ Figures (--figures, comma-separated):
                Figures share runs with the same settings (each runs once).
 
 --quick 1: copper ore only, few particles, 2-3 energies (Figs. 9-10: one level, the 50 %; Fig.
-11: 5 impacts, gamma 5 and 10) (tests/test_verify.py; under 3 minutes).
-Every run is a scenes.single_impacts call (Fig. 8's drop weight: scenes.drop_weight_scene;
-Fig. 11: scenes.impact_scene and impact_again, in this process); the results are
+11: 5 impacts, gamma 5 and 10; Figs. 13-19: 2 particles at 1000 J/kg, 2 % RT)
+(tests/test_verify.py; about a minute). The whole command: docs/verification.md (46 minutes).
+Every run is a scenes.single_impacts call (drop weight: scenes.drop_weight_scene and
+run_drop_weight; Fig. 11: scenes.impact_scene and impact_again, in this process); the results are
 model.reports.breakage_result_of dicts, written to <out>/results.json with their settings. YADE
 runs in this process (the coupling makes it importable); --jobs > 1 shares each run's scenes
 among YADE processes.
