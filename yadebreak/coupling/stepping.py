@@ -256,16 +256,17 @@ class FragmentDamping:
     refused (attach's global_damping sets one for all). docs/high_energy.md, "Global damping"."""
 
     def __init__(self, strengths, duration):
-        self.strengths = dict(strengths)      # material label -> strength in [0, 1)
-        self.duration = duration              # s, or None: for the fragment's life
-        nonzero = sorted({v for v in self.strengths.values() if v > 0.0})
+        """strengths: material label -> strength in [0, 1); duration: s, or None (for the
+        fragment's life)."""
+        self.duration = duration
+        nonzero = sorted({v for v in strengths.values() if v > 0.0})
         if len(nonzero) > 1:
             raise AttachError(
                 f"global_damping: the materials' files give {nonzero} (by label: "
-                f"{self.strengths}) but YADE's Newton damping is one value per scene: pass "
+                f"{dict(strengths)}) but YADE's Newton damping is one value per scene: pass "
                 f"global_damping (in [0, 1)) to attach() for all")
         self.strength = nonzero[0] if nonzero else 0.0
-        self.damped_labels = {lab for lab, v in self.strengths.items() if v > 0.0}
+        self.damped_labels = {lab for lab, v in strengths.items() if v > 0.0}
         self.until = []                       # [time (s), [ids]]
 
     def apply_at_attach(self):

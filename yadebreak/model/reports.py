@@ -147,15 +147,19 @@ class ImpactTally:
 
     @classmethod
     def from_dict(cls, data):
-        resolved = data.get("resolved_mass")       # absent in tallies written before it
         return cls(**{**data, "progeny_mass": np.array(data["progeny_mass"]),
                       "marker_mass": np.array(data["marker_mass"]),
-                      "resolved_mass": None if resolved is None else np.array(resolved)})
+                      "resolved_mass": np.array(data["resolved_mass"])})
 
     @property
     def broken(self):
         """The first events that were breakages."""
         return [e for e in self.first if e["kind"] == "breakage"]
+
+    @property
+    def broken_mass(self):
+        """Mass (kg) of the fired particles that broke: what the progeny curves are shares of."""
+        return sum(e["mass"] for e in self.broken)
 
     @property
     def mass_relative_error(self):
@@ -190,7 +194,7 @@ def breakage_result_of(tally, material, specific_energy, partner):
     if not broken:
         result["t10_note"] = "no particle broke: no progeny to measure"
         return result
-    parent_mass = sum(e["mass"] for e in broken)
+    parent_mass = tally.broken_mass
     passing = 100 * tally.progeny_mass / parent_mass
     markers = 100 * tally.marker_mass / parent_mass
     result.update({
@@ -210,7 +214,7 @@ def breakage_result_of(tally, material, specific_energy, partner):
 def resolved_progeny_passing(tally):
     """Passing (%) of the broken particles' progeny at tally.size x RELATIVE_SIEVES counting the
     spheres as they stand in the scene (no fines: the paper's Fig. 13); None if none broke."""
-    parent_mass = sum(e["mass"] for e in tally.broken)
+    parent_mass = tally.broken_mass
     return (100 * tally.resolved_mass / parent_mass).tolist() if parent_mass else None
 
 

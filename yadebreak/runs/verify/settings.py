@@ -69,7 +69,6 @@ class Runner:
     def __init__(self, jobs):
         self.jobs = jobs
         self.results = {}
-        self.wall = {}
 
     def run(self, run):
         from yadebreak import scenes
@@ -87,13 +86,14 @@ class Runner:
                         run.per_scene, run.seed, target=run.target, jobs=self.jobs,
                         wait_for_arrivals=True, **run.options)
                 result = reports.breakage_result_of(tally, mat, energy, steel)
-                result["progeny_passing_resolved"] = reports.resolved_progeny_passing(tally)
                 if run.options.get("replace") is False:      # no progeny: no t10 to show
                     for name in ("t10_simulated", "t10_primary_events", "progeny_markers",
                                  "relative_sizes", "progeny_passing_simulated",
-                                 "progeny_passing_model", "progeny_passing_resolved"):
+                                 "progeny_passing_model"):
                         result.pop(name, None)
                     result["t10_note"] = "broken particles not replaced (probability only)"
+                else:
+                    result["progeny_passing_resolved"] = reports.resolved_progeny_passing(tally)
                 result.update(steps=tally.steps, scenes_at_step_limit=tally.scenes_at_step_limit,
                               wall_s=time.time() - began, material=mat.name, size=run.size,
                               options=run.options, seed=run.seed, test=run.test)
