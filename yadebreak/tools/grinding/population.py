@@ -15,6 +15,12 @@ energy e_j of that row (one for all caught particles). In a cell of fracture ene
 - e_j / E < drift_ratio: many such mild stressings per step, each weakening by less than
   D(drift_ratio): applied as their mean rate of weakening, d ln E / dt = sum lambda ln(1 - D).
 Mass moves between cells, classes and fines and is never created: it is conserved to round-off.
+
+Two switches mirror the conventions of the DEM engine (off by default): t10_at="threshold" takes
+every breakage's t10 at the fracture threshold (ratio 1, Eq. 9) instead of at e_j / E;
+progeny_dmin makes progeny whose own progeny would be finer than it (0.210 d < progeny_dmin)
+unbreakable: never damaged, and the first stressing past their fracture energy records its t10
+and stops their stressing; the product spreads them by Eq. 10 at that t10 (Eq. 13).
 """
 from __future__ import annotations
 
@@ -35,9 +41,11 @@ class GrindingError(ValueError):
 
 @dataclass
 class GrindResult:
-    """Histories at the output times. masses (T, classes) kg, fines (T,) kg; rates (T, classes)
+    """Histories at the output times. masses (T, classes) kg, fines (T,) kg: the product (with
+    progeny_dmin, once-broken unbreakable progeny spread by Eq. 10, Eq. 13); rates (T, classes)
     1/s over the interval ending at each time (NaN at t = 0 and for empty classes); passing (T,
-    sieves) %; specific energies (T,) J/kg of ore."""
+    sieves) %; specific energies (T,) J/kg of ore; once_broken (T,) kg: unbreakable progeny
+    stressed past their fracture energy (0 without progeny_dmin)."""
 
     classes: SizeClasses
     times_s: np.ndarray
@@ -51,6 +59,7 @@ class GrindResult:
     discharged_mass: float
     steps: int
     runtime_s: float
+    once_broken: np.ndarray = None
 
     @property
     def passing_percent(self):
@@ -86,15 +95,38 @@ class BatchGrinder:
     breakage_matrix: (classes + 1, classes) fractions of a class's broken mass (column) going to
     each class and the fines (row), replacing Eqs. 8-10 (tests, classical models);
     holdup_mass: kg of ore the spectra act on (default: the spectra's ore mass).
+
+    Conventions of the DEM engine, for comparing with it (default off: the model as published):
+    t10_at: "collision" (default) takes a breakage's t10 from Eq. 8 at e_j / E; "threshold" at
+    the fracture threshold, ratio 1 (Eq. 9's t10_min), as the engine does when it breaks a
+    particle at the first read past its fracture energy. progeny_dmin (m): progeny of a class
+    whose own progeny would be finer than it (X_MIN d < progeny_dmin, the engine's dmin rule)
+    are unbreakable: never damaged, and the first stressing past their fracture energy (fresh,
+    Eqs. 1-3 at their class's size) records a t10 (by t10_at) and ends their stressing; they stay
+    in the charge at their size and the product spreads them by Eq. 10 at that t10 (Eq. 13).
+    Feed particles always break.
     """
 
     def __init__(self, material, spectra, classes, cells=120, drift_ratio=0.2,
-                 max_stressed=0.05, damage=True, breakage_matrix=None, holdup_mass=None):
+                 max_stressed=0.05, damage=True, breakage_matrix=None, holdup_mass=None,
+                 t10_at="collision", progeny_dmin=None):
         _check_material(material)
         if not 0.0 < drift_ratio < 1.0:
             raise GrindingError(f"drift_ratio = {drift_ratio}: accepted 0 < drift_ratio < 1")
         if not 0.0 < max_stressed <= 0.5:
             raise GrindingError(f"max_stressed = {max_stressed}: accepted (0, 0.5]")
+        if t10_at not in ("collision", "threshold"):
+            raise GrindingError(f"t10_at = {t10_at!r}: accepted 'collision' or 'threshold'")
+        if progeny_dmin is not None and not progeny_dmin > 0.0:
+            raise GrindingError(f"progeny_dmin = {progeny_dmin} m: accepted > 0 (or None: off)")
+        if breakage_matrix is not None and (t10_at != "collision" or progeny_dmin is not None):
+            raise GrindingError("breakage_matrix: replaces Eqs. 8-10, so t10_at and progeny_dmin "
+                                "cannot be used with it")
+        self.t10_at = t10_at
+        self.progeny_dmin = progeny_dmin
+        # classes whose progeny are unbreakable (the engine's rule: X_MIN d < dmin)
+        self.unbreakable_class = (np.zeros(classes.count, bool) if progeny_dmin is None
+                                  else model.X_MIN * classes.sizes < progeny_dmin)
         self.material, self.spectra, self.classes = material, spectra, classes
         self.n, self.cells = classes.count, int(cells)
         self.sizes = classes.sizes
@@ -187,35 +219,56 @@ class BatchGrinder:
         class_masses = np.asarray(class_masses, dtype=float)
         return class_masses[:, None] * self.fresh, float(fines)
 
+    def _initial(self, class_masses, fines):
+        cells, fines = self.fresh_state(class_masses, fines)
+        if self.progeny_dmin is None:
+            return _State(cells, fines)
+        return _State(cells, fines, np.zeros_like(cells),
+                      np.zeros((self.n, len(self.t10_grid))))
+
+    def product(self, state):
+        """(mass per class, fines) in kg of the product: what a sieve sees, once-broken unbreakable
+        progeny spread by Eq. 10 at their t10 (Eq. 13)."""
+        masses, fines = state.cells.sum(axis=1), state.fines
+        if state.unbreakable is None:
+            return masses, fines
+        spread = np.einsum("ig,igl->l", state.spent, self.progeny)
+        return masses + state.unbreakable.sum(axis=1) + spread[:self.n], fines + spread[self.n]
+
     def stressing(self, cells, fines):
         """Per spectrum row, the specific energy e_j (J/kg) of each caught particle for the
         charge's present composition, and nbar_j (capture.py)."""
-        total = cells.sum() + fines
-        fractions = np.append(cells.sum(axis=1), fines) / total
+        return self._stressing_of(cells.sum(axis=1), fines)
+
+    def _stressing_of(self, class_masses, fines):
+        """stressing() for the charge's mass per class (kg, at their physical sizes) and fines."""
+        total = class_masses.sum() + fines
+        fractions = np.append(class_masses, fines) / total
         e = self.capture.specific_energy(self.energy, fractions, self.all_sizes, self.plane)
         nbar = self.capture.expected_count(fractions, self.all_sizes, self.plane)
         return e, nbar
 
-    def _rates(self, cells, fines):
+    def _rates(self, class_masses, fines):
         """The step's rates: ln r (n, J, K), stochastic rates q (n, J, K), their sum Q (n, K),
         the drift of ln E (n, K), e_j, nbar_j."""
-        e, nbar = self.stressing(cells, fines)
+        e, nbar = self._stressing_of(class_masses, fines)
         log_r = np.log(e)[None, :, None] - self.log_e[:, None, :]
         big = log_r >= self.log_drift
         q = np.where(big, self.lam[:, :, None], 0.0)
         drift = np.where(big, 0.0, self.lam[:, :, None] * self.log_keep(np.minimum(log_r, 0.0)))
         return log_r, q, q.sum(axis=1), drift.sum(axis=1), e, nbar
 
-    def _largest_step(self, cells, total, drift):
+    def _largest_step(self, state, total, drift):
         """The longest step (s) in which no class has more than max_stressed of its mass
         stressed (above drift_ratio) and no cell holding mass drifts by more than a quarter of
         a cell. Weighted by mass: nearly empty cells (far down the grid, where every event breaks)
         do not limit the step; the exponential loss keeps them exact anyway."""
+        cells = state.cells
         mass = cells.sum(axis=1)
         limit = math.inf
-        stressed = (total * cells).sum(axis=1)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            per_class = np.where(mass > 0, stressed / mass, 0.0)
+        per_class = _stressed_share(cells, total)
+        if state.unbreakable is not None:
+            per_class = np.maximum(per_class, _stressed_share(state.unbreakable, total))
         if per_class.max() > 0:
             limit = self.max_stressed / per_class.max()
         holding = cells > 1e-6 * np.maximum(mass[:, None], 1e-300)
@@ -224,13 +277,51 @@ class BatchGrinder:
             limit = min(limit, 0.25 / speed)
         return limit
 
-    def step(self, cells, fines, dt_max):
-        """Advance (cells, fines) by at most dt_max s (less if _largest_step says so). Returns
-        (cells, fines, dt, broken-out mass per class (kg, net of progeny staying in the class),
+    def step(self, state, dt_max):
+        """Advance `state` by at most dt_max s (less if _largest_step says so). Returns
+        (state, dt, broken-out mass per class (kg, net of progeny staying in the class),
         energy given to caught ore (J))."""
         n = self.n
-        log_r, q, total, drift, e, nbar = self._rates(cells, fines)
-        dt = min(dt_max, self._largest_step(cells, total, drift))
+        physical = state.cells.sum(axis=1)
+        if state.unbreakable is not None:     # stressed-once progeny stay in the charge whole
+            physical = physical + state.unbreakable.sum(axis=1) + state.spent.sum(axis=1)
+        log_r, q, total, drift, e, nbar = self._rates(physical, state.fines)
+        dt = min(dt_max, self._largest_step(state, total, drift))
+        new, broken, log_b = self._stress(state.cells, log_r, q, total, drift * dt, dt,
+                                          self.damage_on)
+        broken_class = broken.sum(axis=(1, 2))
+        if self.matrix is not None:
+            progeny = self.matrix @ broken_class
+            same = np.diag(self.matrix[:n]) * broken_class
+        else:
+            weights = self._t10_weights(broken, self._t10(log_b))          # (n, G)
+            per_class = np.einsum("ig,igl->il", weights, self.progeny)     # (n, n+1)
+            progeny = per_class.sum(axis=0)
+            same = np.diag(per_class[:, :n])
+        left = broken_class - same
+        fines = state.fines + progeny[n]
+        energy = float(np.sum(self.rate * self.energy * -np.expm1(-nbar))) * dt
+        if state.unbreakable is None:
+            new += progeny[:n, None] * self.fresh
+            return _State(new, fines), dt, left, energy
+        # unbreakable progeny: no damage; a stressing past E records t10 and ends their stressing
+        unb, broken_u, log_bu = self._stress(state.unbreakable, log_r, q, total,
+                                             np.zeros_like(self.log_e), dt, False)
+        once = self._t10_weights(broken_u, self._t10(log_bu))              # (n, G)
+        spread = np.einsum("ig,igl->il", once, self.progeny)
+        left = left + once.sum(axis=1) - np.diag(spread[:, :n])            # as a sieve sees it
+        to_unb = np.where(self.unbreakable_class, progeny[:n], 0.0)
+        new += (progeny[:n] - to_unb)[:, None] * self.fresh
+        unb += to_unb[:, None] * self.fresh
+        return _State(new, fines, unb, state.spent + once), dt, left, energy
+
+    def _stress(self, cells, log_r, q, total, shift, dt, damage):
+        """One step's stressing of a pool of particles (n, K): every cell loses the fraction
+        1 - exp(-Q dt), shared among the rows by their rates; of a row's part, the share of the
+        cell below ln e_j breaks (the cell's mass uniform in ln E), the rest survives at its mean
+        ln E, weakened by Eq. 6 if `damage`; the unstressed part drifts by `shift` (n, K).
+        Returns (the survivors on the grid (n, K), broken mass (n, J, K), the broken part's mean
+        ln(e_j / E) (n, J, K))."""
         stressed = -np.expm1(-total * dt)                                  # (n, K)
         with np.errstate(invalid="ignore", divide="ignore"):
             f = np.where(total[:, None, :] > 0, q * (stressed / total)[:, None, :], 0.0)
@@ -239,31 +330,28 @@ class BatchGrinder:
         mass = cells[:, None, :]
         broken = f * phi * mass                                            # (n, J, K)
         survive = f * (1.0 - phi) * mass
-        shift = drift * dt                                                 # (n, K)
         # survivors of the stressed part: their mean ln E (the cell above ln e), weakened
         log_e = self.log_e[:, None, :]
         log_ej = log_r + log_e
         log_s = 0.5 * (np.maximum(log_ej, log_e - half) + log_e + half)
-        target_s = log_s + self.log_keep(np.minimum(log_ej - log_s, 0.0)) + shift[:, None, :]
+        target_s = log_s + shift[:, None, :]
+        if damage:
+            target_s = target_s + self.log_keep(np.minimum(log_ej - log_s, 0.0))
         keep = cells * (1.0 - stressed)
         new = self._deposit(keep, self.log_e + shift, survive, target_s)
-        # breakage: t10 (Eq. 8) at the broken part's mean ratio, progeny (Eq. 10)
-        broken_class = broken.sum(axis=(1, 2))
-        if self.matrix is not None:
-            progeny = self.matrix @ broken_class
-            same = np.diag(self.matrix[:n]) * broken_class
-        else:
-            log_b = log_ej - 0.5 * (log_e - half + np.minimum(log_ej, log_e + half))
-            ratio_b = np.exp(np.maximum(log_b, 0.0))
-            t10 = self.material.t10(ratio_b)
-            weights = self._t10_weights(broken, t10)                       # (n, G)
-            per_class = np.einsum("ig,igl->il", weights, self.progeny)     # (n, n+1)
-            progeny = per_class.sum(axis=0)
-            same = np.diag(per_class[:, :n])
-        new += progeny[:n, None] * self.fresh
-        fines = fines + progeny[n]
-        energy = float(np.sum(self.rate * self.energy * -np.expm1(-nbar))) * dt
-        return new, fines, dt, broken_class - same, energy
+        log_b = log_ej - 0.5 * (log_e - half + np.minimum(log_ej, log_e + half))
+        return new, broken, log_b
+
+    def _t10(self, log_ratio):
+        """t10 (%) of breakages at mean ln(e_j / E) `log_ratio`: Eq. 8 at the ratio (at least 1),
+        or Eq. 9's t10_min for t10_at="threshold"."""
+        return self._t10_at_ratio(np.exp(np.maximum(log_ratio, 0.0)))
+
+    def _t10_at_ratio(self, ratio):
+        """t10 (%) of breakages at e_j / E = `ratio` (>= 1), by t10_at."""
+        if self.t10_at == "threshold":
+            return np.full(np.shape(ratio), self.material.t10_min)
+        return self.material.t10(ratio)
 
     def _deposit(self, keep, keep_at, moved, moved_at):
         """Masses `keep` (n, K) at ln E `keep_at` and `moved` (n, J, K) at `moved_at` put back
@@ -289,11 +377,11 @@ class BatchGrinder:
         progress(t_s, wall_s) is called about every 5 s of wall time."""
         start = time.time()
         out_t = np.asarray(output_times_s, dtype=float)
-        cells, fines = self.fresh_state(class_masses, fines)
-        feed_cells, feed_fines = cells.copy(), fines
-        initial = float(cells.sum() + fines)
-        masses, fines_h, rates = [cells.sum(axis=1)], [fines], [np.full(self.n, np.nan)]
-        e_coll, e_abs = [0.0], [0.0]
+        state = self._initial(class_masses, fines)
+        feed = state
+        initial = float(state.cells.sum() + state.fines)
+        masses, fines_h, rates = [state.cells.sum(axis=1)], [state.fines], [np.full(self.n, np.nan)]
+        e_coll, e_abs, once = [0.0], [0.0], [0.0]
         t, steps, fed, discharged, absorbed = 0.0, 0, 0.0, 0.0, 0.0
         last = start
         for t_out in out_t[1:] if out_t[0] == 0.0 else out_t:
@@ -303,15 +391,14 @@ class BatchGrinder:
                 dt = t_out - t
                 if residence_time_s:
                     dt = min(dt, 0.05 * residence_time_s)
-                before = cells.sum(axis=1)
-                cells, fines, dt, left, energy = self.step(cells, fines, dt)
+                before = self.product(state)[0]
+                state, dt, left, energy = self.step(state, dt)
                 if residence_time_s:
                     out_share = -math.expm1(-dt / residence_time_s)
-                    discharged += out_share * float(cells.sum() + fines)
-                    cells, fines = cells * (1 - out_share), fines * (1 - out_share)
-                    cells, fines = cells + out_share * feed_cells, fines + out_share * feed_fines
+                    discharged += out_share * state.total()
+                    state = state.mixed(out_share, feed)
                     fed += out_share * initial
-                exposure += _mean_mass(before, cells.sum(axis=1)) * dt
+                exposure += _mean_mass(before, self.product(state)[0]) * dt
                 left_class += left
                 absorbed += energy
                 t += dt
@@ -320,8 +407,10 @@ class BatchGrinder:
                 if progress is not None and now - last > 5.0:
                     progress(t, now - start)
                     last = now
-            masses.append(cells.sum(axis=1))
-            fines_h.append(fines)
+            product, product_fines = self.product(state)
+            masses.append(product)
+            fines_h.append(product_fines)
+            once.append(0.0 if state.spent is None else float(state.spent.sum()))
             with np.errstate(invalid="ignore", divide="ignore"):
                 rates.append(np.where(exposure > 0, left_class / exposure, np.nan))
             e_coll.append(self.collision_power * t / self.holdup)
@@ -329,14 +418,15 @@ class BatchGrinder:
         times = out_t if out_t[0] == 0.0 else np.concatenate([[0.0], out_t])
         return GrindResult(self.classes, times, np.array(masses), np.array(fines_h),
                            np.array(rates), np.array(e_coll), np.array(e_abs), initial, fed,
-                           discharged, steps, time.time() - start)
+                           discharged, steps, time.time() - start, np.array(once))
 
     def initial_rates(self, class_masses, fines=0.0, net=False, quantiles=20000):
         """Each class's breakage rate (1/s) at t = 0 from the fresh distributions (Eqs. 1-3),
         without integrating: S_i = sum_j lambda_ij P_i(e_j), every breakage counted (gross). With
         net: only the broken mass that leaves the class, the fresh distribution taken at
-        `quantiles` evenly spaced quantiles, each broken particle's t10 from Eq. 8 and its
-        progeny's share below the class from Eq. 10 (what a sieve analysis of the class sees)."""
+        `quantiles` evenly spaced quantiles, each broken particle's t10 from Eq. 8 (or Eq. 9 for
+        t10_at="threshold") and its progeny's share below the class from Eq. 10 (what a sieve
+        analysis of the class sees)."""
         cells, fines = self.fresh_state(class_masses, fines)
         e, _ = self.stressing(cells, fines)
         if not net:
@@ -347,7 +437,7 @@ class BatchGrinder:
         for i, d in enumerate(self.sizes):
             energy = self.material.fracture_energy_ppf(u, d)                   # (Q,)
             ratio = e[:, None] / energy[None, :]                               # (J, Q)
-            leaving = 1.0 - self._retained(i, self.material.t10(np.maximum(ratio, 1.0)))
+            leaving = 1.0 - self._retained(i, self._t10_at_ratio(np.maximum(ratio, 1.0)))
             out[i] = np.sum(self.lam[i] * np.mean(np.where(ratio >= 1.0, leaving, 0.0), axis=1))
         return out
 
@@ -357,6 +447,42 @@ class BatchGrinder:
         if self.matrix is not None:
             return np.full(np.shape(t10), self.matrix[i, i])
         return np.interp(t10, self.t10_grid, self.progeny[i, :, i])
+
+
+@dataclass
+class _State:
+    """The charge: breakable particles on each class's fracture-energy grid (n, K) kg, the fines
+    kg; with progeny_dmin, the unbreakable progeny not yet stressed past their fracture energy
+    (n, K) kg and those that were, on the t10 grid (n, G) kg (kept whole in the charge, spread
+    by Eq. 10 in the product)."""
+
+    cells: np.ndarray
+    fines: float
+    unbreakable: np.ndarray = None
+    spent: np.ndarray = None
+
+    def total(self):
+        extra = 0.0 if self.unbreakable is None else self.unbreakable.sum() + self.spent.sum()
+        return float(self.cells.sum() + self.fines + extra)
+
+    def mixed(self, share, feed):
+        """The charge after `share` of it is discharged and replaced by `feed`."""
+        keep = 1.0 - share
+        if self.unbreakable is None:
+            return _State(self.cells * keep + share * feed.cells,
+                          self.fines * keep + share * feed.fines)
+        return _State(self.cells * keep + share * feed.cells,
+                      self.fines * keep + share * feed.fines,
+                      self.unbreakable * keep + share * feed.unbreakable,
+                      self.spent * keep + share * feed.spent)
+
+
+def _stressed_share(cells, total):
+    """Per class, the share of its mass (n, K) stressed per s at the rates Q (n, K); 0 if empty."""
+    mass = cells.sum(axis=1)
+    stressed = (total * cells).sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(mass > 0, stressed / mass, 0.0)
 
 
 def _split_linear(pos, mass, count):
