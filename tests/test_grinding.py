@@ -18,6 +18,7 @@ from yadebreak.tools.grinding import (BatchGrinder, GrindingError, SpectraError,
 from yadebreak.tools.grinding.capture import PACKING_MONOLAYER
 from yadebreak.tools.grinding.classes import FeedError
 from yadebreak.model.materials import load_material
+from yadebreak import model
 
 COPPER = load_material("copper_ore")
 #: copper ore so weak (E50 ~ 1e-9 J/kg) that every stressed particle breaks: the model reduces
@@ -97,6 +98,110 @@ def test_three_classes_with_a_known_breakage_matrix_follow_reid():
         assert res.mass_relative_error < 1e-13
     assert errors[1] < 2e-3                 # 0.072 % of the feed measured at 2 %/step
     assert errors[0] / errors[1] == pytest.approx(2.0, rel=0.15)    # first order in the step
+
+
+# --------------------------------------------------------------------------- the DEM's conventions
+def eq10_split(classes, i, t10):
+    """Eq. 10 at t10 (%) for a parent of class i: the fractions landing in each class (those
+    coarser than class i's lower sieve stay in it) and, last, the fines."""
+    passing = model.progeny_passing(t10, BRITTLE.beta_params,
+                                    classes.sieves[i:] / classes.sizes[i]) / 100.0
+    passing[0] = 1.0
+    out = np.zeros(classes.count + 1)
+    out[i:classes.count] = passing[:-1] - passing[1:]
+    out[-1] = passing[-1]
+    return out
+
+
+def test_t10_at_threshold_gives_every_breakage_eq9s_t10():
+    """After one step from a one-class feed (progeny join their classes at its end, unbroken),
+    the product below the feed class is Eq. 10 at Eq. 9's t10_min, whatever the collision's
+    energy: here e_j / E ~ 1e9, where Eq. 8 gives t10 ~ A."""
+    sp = synthetic_spectra(0.025, bins=10)
+    d = 2e-3
+    classes = single_size(d, 4)
+    m, f = feed_masses(classes, d, sp.ore_mass_kg)
+    expected = eq10_split(classes, 0, BRITTLE.t10_min)[1:]
+    below = {}
+    for t10_at in ("threshold", "collision"):
+        res = BatchGrinder(BRITTLE, sp, classes, cells=30, t10_at=t10_at).run(m, f, [0.0, 0.05])
+        assert res.steps == 1 and res.masses[1, 0] < 0.999 * m[0]
+        below[t10_at] = np.append(res.masses[1, 1:], res.fines[1])
+    np.testing.assert_allclose(below["threshold"] / below["threshold"].sum(),
+                               expected / expected.sum(), rtol=1e-10)
+    assert below["collision"][-1] / below["collision"].sum() > 5 * expected[-1] / expected.sum()
+
+
+def test_progeny_dmin_makes_progeny_break_once_and_be_spread_by_eq10():
+    """Every stressed particle breaks (BRITTLE) and no progeny may break again (progeny_dmin 1 m
+    against classes of 2 mm): the feed leaves at S_0, its progeny (Eq. 10 at t10_min, the part
+    coarser than the class's lower sieve staying in it) join unbreakable pools that are
+    stressed at S_l and, stressed once, are spread by Eq. 10 at t10_min and stop. That linear
+    system (matrix exponential) gives the product and the mass stressed once, to the step's
+    first-order error (progeny join at the step's end)."""
+    sp = synthetic_spectra(0.025, bins=10)
+    d = 2e-3
+    classes = single_size(d, 4)
+    n = classes.count
+    m, f = feed_masses(classes, d, sp.ore_mass_kg)
+    t10 = BRITTLE.t10_min
+    s = np.array([capture_rate(sp, di, sp.ore_mass_kg) for di in classes.sizes])
+    b = eq10_split(classes, 0, t10)
+    # state: feed, unbreakable pools u_0..u_(n-1), stressed-once pools w_0..w_(n-1)
+    a = np.zeros((1 + 2 * n, 1 + 2 * n))
+    a[0, 0] = -s[0]
+    a[1:n + 1, 0] = b[:n] * s[0]
+    a[range(1, n + 1), range(1, n + 1)] = -s
+    a[range(n + 1, 2 * n + 1), range(1, n + 1)] = s
+    spread = np.array([eq10_split(classes, i, t10) for i in range(n)])       # (n, n + 1)
+    times = np.array([0.0, 2.0, 6.0])
+    exact = []
+    for t in times:
+        x = expm(a * t) @ np.concatenate([[m[0]], np.zeros(2 * n)])
+        product = np.append(x[1:n + 1], b[n] * (m[0] - x[0])) + x[n + 1:] @ spread
+        product[0] += x[0]
+        exact.append(np.append(product, x[n + 1:].sum()))      # classes, fines, stressed once
+    errors = []
+    for fraction in (0.02, 0.01):
+        g = BatchGrinder(BRITTLE, sp, classes, cells=30, t10_at="threshold", progeny_dmin=1.0,
+                         max_stressed=fraction)
+        assert g.unbreakable_class.all()
+        res = g.run(m, f, times)
+        got = np.column_stack([res.masses, res.fines, res.once_broken])
+        errors.append(np.max(np.abs(got - np.array(exact))) / m[0])
+        assert res.mass_relative_error < 1e-13
+    assert errors[1] < 2e-3                 # 0.14 % of the feed measured at 1 %/step
+    assert errors[0] / errors[1] == pytest.approx(2.0, rel=0.15)    # first order in the step
+    assert res.once_broken[-1] > 0.5 * m[0]                  # the pools did break, once
+    # without the rule the progeny break again and again: a finer product
+    free = BatchGrinder(BRITTLE, sp, classes, cells=30, t10_at="threshold").run(m, f, times)
+    assert free.fines[-1] > 1.25 * res.fines[-1]
+
+
+def test_progeny_dmin_spares_the_feed_and_coarse_enough_progeny():
+    """Only classes with X_MIN d < progeny_dmin receive unbreakable progeny; the feed breaks at
+    its fresh rate whatever the rule (the same as without it over the first step)."""
+    sp = synthetic_spectra(0.025, bins=10)
+    classes = single_size(8e-3, 6)
+    limit = model.X_MIN * classes.sizes[2] * 1.001                # classes 2.. are below it
+    g = BatchGrinder(COPPER, sp, classes, cells=40, progeny_dmin=limit)
+    np.testing.assert_array_equal(g.unbreakable_class, [False, False, True, True, True, True])
+    m, f = feed_masses(classes, 8e-3, sp.ore_mass_kg)
+    with_rule = g.run(m, f, [0.0, 1e-3])
+    without = BatchGrinder(COPPER, sp, classes, cells=40).run(m, f, [0.0, 1e-3])
+    np.testing.assert_allclose(with_rule.masses, without.masses, rtol=1e-12)
+    cont = g.run(m, f, [0.0, 60.0], residence_time_s=20.0)
+    assert cont.once_broken[-1] > 0 and cont.mass_relative_error < 1e-13
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"t10_at": "read"}, "t10_at = 'read'"),
+    ({"progeny_dmin": 0.0}, "progeny_dmin = 0.0 m"),
+    ({"t10_at": "threshold", "breakage_matrix": np.eye(5, 4)}, "breakage_matrix"),
+])
+def test_bad_convention_options_are_refused(options, message):
+    with pytest.raises(GrindingError, match=message):
+        BatchGrinder(COPPER, synthetic_spectra(0.025), single_size(2e-3, 4), cells=20, **options)
 
 
 # --------------------------------------------------------------------------- capture model
