@@ -243,15 +243,19 @@ def _scene(seed):
     return st, [criteria.criterion_for(m) for m in mats], loading
 
 
+@pytest.mark.parametrize("at_peak", (False, True))
 @pytest.mark.parametrize("seed", range(6))
-def test_both_judge_paths_make_the_same_decisions(seed):
+def test_both_judge_paths_make_the_same_decisions(seed, at_peak):
     results = []
     for path in ("plan_each", "plan_all"):
         st, crits, loading = _scene(seed)
+        if at_peak:                   # some bodies passed their threshold at an earlier read
+            ids = np.array(sorted(st.tracked))
+            st.table.columns["cracked"][ids[::3]] = 1
         records = []
         judge = judging.Judge(st, crits, ContactReader({}, 0.0, 1e-4), 0.7 if seed % 2 else 1.0,
                               True, 0.02, lambda kind, i, **f: records.append((kind, i, f)),
-                              lambda *a: None)
+                              lambda *a: None, at_peak)
         candidates = list(st.open_events.union(loading.energy))
         plan = getattr(judge, path)(candidates, loading, 3, 10, True)
         broken = judge.settle(candidates, plan, loading)
@@ -293,3 +297,35 @@ def test_kappa_successive_sets_eq8_for_fragments_only():
     assert cfg.criteria.kappa_successive == 0.5
     with pytest.raises(config.AttachError, match="kappa_successive"):
         config.Config.from_options(kappa_successive=0.0)
+
+
+@pytest.mark.parametrize("kind", (BREAKABLE, UNBREAKABLE))
+def test_break_at_peak_waits_for_the_event_to_stop_rising_and_takes_its_largest_energy(kind):
+    """break_at="threshold" (the paper): the body breaks at the first read above its fracture
+    energy, Ek' of that read. "peak": it is marked cracked there, breaks at the first read whose
+    energy no longer rises (here falling back below the threshold), with the event's largest Ek'
+    for Eq. 8; an unbreakable fragment's recorded t10' is the same."""
+    cu = load_material("copper_ore")
+    mass, energy = 2e-3, 400.0                          # kg, J/kg
+    history = [300.0, 450.0, 600.0, 390.0]              # J/kg at four reads
+    found = {}
+    for at_peak in (False, True):
+        st = EngineState(["ore"], 0)
+        st.table.add([0], kind, "ore", mass, 5e-3, fracture_energy=energy,
+                     fracture_energy_initial=energy)
+        st.tracked.add(0)
+        judge = judging.Judge(st, [criteria.criterion_for(cu)], ContactReader({}, 0.0, 1e-4),
+                              1.0, False, 0.02, lambda *a, **f: None, lambda *a: None, at_peak)
+        for read, specific in enumerate(history):
+            loading = Loading({0: specific * mass})
+            broken, _ = judge.judge(loading, 1, read, False)
+            if broken:
+                found[at_peak] = (read, broken[0][1])
+                break
+    assert found[False] == (1, pytest.approx(450.0 * mass))
+    assert found[True] == (3, pytest.approx(600.0 * mass))
+    ratio, t10, _ = criteria.criterion_for(cu).breakage(st.table, 0, found[True][1])
+    assert ratio == pytest.approx(1.5)
+    assert t10 == pytest.approx(float(model.t10(1.5, cu.A, cu.b_prime, cu.kappa)))
+    with pytest.raises(config.AttachError, match="break_at"):
+        config.Config.from_options(break_at="late")

@@ -35,6 +35,24 @@ def test_model_t10_follows_eq7_rises_with_energy_and_tends_to_a():
 
 
 @pytest.mark.yade
+def test_t10_standard_error_is_the_ratio_estimators_over_the_scenes():
+    """t10 = sum of the scenes' passing over their broken mass; its standard error from the
+    scatter between scenes: sqrt(n / (n - 1) sum (p_i - t m_i)^2) / sum m_i. Two equal scenes
+    at 2 % and 4 % of 1 kg: t10 3 %, error sqrt(2 (0.01^2 + 0.01^2)) / 2 = 1 %; merged tallies
+    keep every scene; one scene gives no error."""
+    from yadebreak.model.reports import ImpactTally
+    a, b = ImpactTally(0.029), ImpactTally(0.029)
+    a.scene_t10.append([1.0, 0.02])
+    assert a.t10_standard_error is None
+    b.scene_t10.append([1.0, 0.04])
+    a.merge(ImpactTally.from_dict(json.loads(json.dumps(b.to_dict()))))
+    assert a.t10_standard_error == pytest.approx(1.0, rel=1e-12)
+    a.scene_t10.append([2.0, 0.06])               # the third at the mean: n/(n-1) = 3/2
+    t = 0.12 / 4.0
+    expected = 100 * np.sqrt(1.5 * ((0.02 - t) ** 2 + (0.04 - t) ** 2)) / 4.0
+    assert a.t10_standard_error == pytest.approx(expected, rel=1e-12)
+
+
 def test_fragments_go_on_breaking_after_the_originals_broke(scene):
     """Four 5.5 mm copper ore particles at 1500 J/kg (the model breaks 90 % of them): the run
     follows the fragments, later generations break, and the progeny is finer than the same

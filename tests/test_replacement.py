@@ -144,3 +144,44 @@ def test_t10_of_low_energy_single_impacts_matches_eq8(scene):
     ]:
         got = 100 * brk.size_distribution([d / 10], fines_model=fines).passing_mass[0] / parent_mass
         assert got == pytest.approx(expected, rel=0.15), fines
+
+
+def test_softer_dummies_differ_from_their_parent_in_stiffness_only(scene):
+    """dummy_stiffness=0.1: the dummy spheres get '<label>_dummy', a copy of the ore's YADE
+    material with a tenth of its Young's modulus, whose restitution and friction against every
+    material are the ore's (the Ip2's MatchMakers); the resolved fragments keep the ore's; the
+    reader sees the dummies' own stiffness (Eq. 4 against them: e = 1 / (1 + kp / kd)); and the
+    time step follows the finest of each material (a softer dummy allows a longer one)."""
+    from yade import O
+    from yadebreak.coupling.scene_materials import DUMMY_SUFFIX
+    brk, bid = _free_sphere(radius=10e-3, dummy_stiffness=0.1)
+    ore = O.bodies[bid].material
+    soft = next(m for m in O.materials if m.label == "ore" + DUMMY_SUFFIX)
+    assert soft.young == pytest.approx(0.1 * ore.young, rel=1e-15)
+    assert (soft.poisson, soft.density, soft.frictionAngle) == (ore.poisson, ore.density,
+                                                                 ore.frictionAngle)
+    ip2 = next(e for e in O.engines if type(e).__name__ == "InteractionLoop").physDispatcher.functors[0]
+    en = {(int(a), int(b)): v for a, b, v in ip2.en.matches}
+    assert en[(soft.id, ore.id)] == en[(soft.id, soft.id)] == en[(ore.id, ore.id)]
+    # breakage until some dummies exist (the families at low t10' may hold none)
+    ev = brk.break_body(bid, ratio=60.0)
+    kinds = {i: brk.bodies[i].kind for i in ev["fragments"]}
+    assert "dummy" in kinds.values()
+    for i, kind in kinds.items():
+        assert O.bodies[i].material.id == (soft.id if kind == "dummy" else ore.id)
+    k_ore, k_soft = (brk.reader.stiffness[m.id] for m in (ore, soft))
+    assert k_soft == pytest.approx(0.1 * k_ore, rel=1e-12)
+    assert float(model.energy_partition(k_ore, k_soft)) == pytest.approx(1 / 11, rel=1e-12)
+    from yadebreak.model import placement
+    finest = {m: min(O.bodies[i].shape.radius for i, k in kinds.items()
+                     if (k == "dummy") == (m is soft)) for m in (ore, soft)}
+    expected = min(0.05 * float(placement.rayleigh_time(r, m.density, m.young, m.poisson))
+                   for m, r in finest.items())
+    assert O.dt == pytest.approx(expected, rel=1e-12)
+
+
+def test_a_dummy_stiffness_out_of_range_is_refused_in_one_line():
+    from yadebreak.coupling import config
+    with pytest.raises(config.AttachError) as err:
+        config.Config.from_options(dummy_stiffness=0.0)
+    assert "dummy_stiffness = 0.0: accepted (0, 1]" in str(err.value)

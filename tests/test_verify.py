@@ -2,10 +2,9 @@
 subset runs, writes its report and plots, its probabilities (single impacts, drop weight, four
 targets, three sizes, repeated impacts) sit within the binomial 3 sigma of the model for those
 very cases, two restitutions give the same probability within 3 sigma of their difference, and
-global damping makes the progeny no coarser than the tolerance below (the paper's finer progeny
-is not reproduced: docs/high_energy.md); the fragmentation figures share their runs, their
-progeny with the fines is at least that of the spheres alone at every size, and Fig. 16's
-check is computed from its run."""
+global damping leaves every primary breakage as it was (it acts on fragments only); the
+fragmentation figures share their runs, their progeny with the fines is at least that of the
+spheres alone at every size, and Fig. 16's check is computed from its run."""
 import json
 
 import pytest
@@ -13,15 +12,6 @@ import pytest
 from yadebreak.runs import verify
 
 pytestmark = pytest.mark.yade
-
-#: Fig. 19's check, as a share of t10 without damping. The paper found its damping made the
-#: progeny finer; here it makes it coarser, and the quick run bounds by how much at its energy.
-#: Measured (docs/high_energy.md, "Global damping"; 29 mm copper ore, 16 particles, seed 3,
-#: 2 % RT): t10 2.18 -> 2.16 % at 300 J/kg, 7.11 -> 6.17 % at 1000 J/kg (-13 %), 13.78 -> 9.34 %
-#: at 3000 J/kg (-32 %); the quick run's 2 particles at 1000 J/kg: 4.25 -> 3.95 % (-7 %). 20 %
-#: at 1000 J/kg is the 16-particle effect with room for the scatter of 2 particles; it fails if
-#: the damping reaches the parents (which also lowers the broken fraction) or doubles its effect.
-DAMPING_TOLERANCE = 0.20
 
 
 def test_the_energies_of_figs_8_10_give_the_model_probabilities_asked():
@@ -62,8 +52,15 @@ def test_quick_verify_writes_its_report_and_meets_its_checks(scene, tmp_path):
         assert all(c["ok"] for c in figures[name]["checks"]), figures[name]["checks"]
     damping = figures["Fig. 19: global damping"]["checks"]
     assert [c["damping"] for c in damping] == [0.3]
-    for c in damping:
-        assert c["t10"] - c["t10_0"] >= -DAMPING_TOLERANCE * c["t10_0"], c
+    # the global damping acts on fragments only: every particle's impact, and so its primary
+    # breakage (energy, t10'), is the same with and without it, to the last bit (the paper's
+    # finer progeny with damping is not reproduced: docs/high_energy.md, "Global damping")
+    by_damping = {r["options"].get("global_damping"): r for r in runs
+                  if r["size"] == 29e-3 and r["options"]["time_step_fraction"] == 0.02
+                  and r["options"].get("cs", 0.0) == 0.0}
+    assert set(by_damping) == {0.0, 0.3}
+    assert by_damping[0.3]["broken_fraction"] == by_damping[0.0]["broken_fraction"] == 1.0
+    assert by_damping[0.3]["t10_primary_events"] == by_damping[0.0]["t10_primary_events"]
     assert all(r["scenes_at_step_limit"] == 0 for r in runs)
     # Figs. 13-19 share runs: 1000 J/kg at 2 % RT with the file's damping (0.3) serves Figs.
     # 13-14, 16, 17 and 19; then 5 % RT (17), damping 0 (18, 19), cs 1 (18): four runs
@@ -81,16 +78,21 @@ def test_quick_verify_writes_its_report_and_meets_its_checks(scene, tmp_path):
 
 
 def test_a_run_waits_for_the_fragments_still_flying_towards_the_plate(scene):
-    """29 mm copper ore at 1000 J/kg, seed 3: the quiet rule alone stopped the run at 121 us with
-    a fragment thrown from the parent's top still heading down at 33 m/s (1 breakage; 4 after
-    20,000 more steps). With wait_for_arrivals nothing heading down faster than 10 % of the
-    impact speed is left in flight, and the cascade is not cut."""
+    """29 mm copper ore at 1000 J/kg, seed 9: the quiet rule alone stops the run with a fragment
+    still heading down faster than 10 % of the impact speed (as at every seed from 1 to 11), after
+    4 breakages; with wait_for_arrivals nothing so fast is left in flight, and it breaks once more
+    (5). The cascade is not cut."""
     from yadebreak import scenes
     from yadebreak.scenes import impacts
     speed = 2000.0 ** 0.5
-    options = dict(seed=3, time_step_fraction=0.02, read_period="every_step", emax_ratio=4.0,
+    options = dict(seed=9, time_step_fraction=0.02, read_period="every_step", emax_ratio=4.0,
                    global_damping=0.0)
-    brk, ids = scenes.impact_scene("copper_ore", 29e-3, speeds=[speed], **options)
-    scenes.run_until_rebound(ids, brk=brk, wait_for_arrivals=True)
-    assert impacts._all_away(0.1 * speed) or impacts._latest_arrival(0.1 * speed) < 1e-5
-    assert len(brk.breakage_events) >= 4
+    counts, flying = [], []
+    for wait in (False, True):
+        brk, ids = scenes.impact_scene("copper_ore", 29e-3, speeds=[speed], **options)
+        scenes.run_until_rebound(ids, brk=brk, wait_for_arrivals=wait)
+        counts.append(len(brk.breakage_events))
+        flying.append(not (impacts._all_away(0.1 * speed)
+                           or impacts._latest_arrival(0.1 * speed) < 1e-5))
+    assert flying == [True, False]
+    assert counts[1] > counts[0], counts

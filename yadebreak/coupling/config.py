@@ -89,6 +89,12 @@ OPTIONS = (
            "> 0 or None", "-",
            "kappa of Eq. 8 for the breakage of fragments (generation >= 1; Tavares materials); "
            "None: the same as the first breakage's (the paper's)"),
+    Option("break_at", "criteria", "threshold", _one_of("threshold", "peak"),
+           "'threshold' or 'peak'", "-",
+           "when a body breaks and which energy gives its t10' (Eq. 8): 'threshold' at the read "
+           "where its energy first passes its fracture energy (the paper); 'peak' once the "
+           "stressing event stops rising, t10' from the event's largest energy (unbreakable "
+           "fragments likewise record the t10' of the event's peak)"),
     Option("emax_ratio", "criteria", None, _number(1, lo_open=True, none=True), "> 1 or None", "-",
            "overrides the material's Emax/E50 (Eq. 2); None keeps the file's"),
     Option("pause_steps", "criteria", None, _count(0, none=True), "an integer >= 0 or None",
@@ -107,6 +113,9 @@ OPTIONS = (
     Option("dummies", "replacement", "spheres", _one_of("spheres", "ledger"),
            "'spheres' or 'ledger'", "-",
            "the unresolved fines: dummy spheres in the scene (the paper) or a mass ledger"),
+    Option("dummy_stiffness", "replacement", 1.0, _number(0, 1, lo_open=True), "(0, 1]", "-",
+           "Young's modulus of the dummy spheres as a share of their parent material's (the "
+           "paper: the fines' class may be softer; dummies='spheres'); 1: the parent's"),
     Option("local_damping", "replacement", 0.0, _number(0, 1), "[0, 1]", "-",
            "share of a fragment's artificial overlap released as real force"),
     Option("zero_overlaps", "replacement", True, _boolean, "True or False", "-",
@@ -150,6 +159,7 @@ class Reading:
 class Criteria:
     kappa: float | None
     kappa_successive: float | None
+    break_at: str
     emax_ratio: float | None
     pause_steps: int | None
     breakage: bool
@@ -161,6 +171,7 @@ class Replacement:
     replace: bool
     dmin: float | None
     dummies: str
+    dummy_stiffness: float
     local_damping: float
     zero_overlaps: bool
     zeroing_tolerance: float
@@ -210,6 +221,9 @@ class Config:
             if not o.check(values[o.name]):
                 unit = "" if o.unit == "-" else f" {o.unit}"
                 problems.append(f"{o.name} = {values[o.name]!r}{unit}: accepted {o.accepted}")
+        if values["dummies"] == "ledger" and values["dummy_stiffness"] != 1.0:
+            problems.append(f"dummy_stiffness = {values['dummy_stiffness']!r}: needs "
+                            "dummies='spheres' (a ledger keeps no dummy spheres)")
         if problems:
             raise AttachError("bad option(s): " + "; ".join(problems))
         groups = {g: kind(**{f.name: values[f.name] for f in fields(kind)})

@@ -85,14 +85,17 @@ class Controller:
              for lab, mat in self.material.items()}, config.time_step.global_damping_time)
         tables = {lab: families.table_for(mat, config.replacement.family_seed)
                   for lab, mat in self.material.items()}
+        dummy_material = (scene_materials.dummy_by_label
+                          if config.replacement.dummy_stiffness != 1.0 else {})
         self.replacer = Replacer(config.replacement, self.state.table, self.state.rng,
                                  self.criteria, tables, self.zeroing, self.reader,
                                  self.state.ledger, self.pause_steps,
-                                 self.damping.damped_labels)
+                                 self.damping.damped_labels, dummy_material)
         self.judge = Judge(self.state, self._criterion_of, self.reader,
                            config.criteria.fragments_energy_factor,
                            any(self.pause_steps.values()), config.reading.fast_tolerance,
-                           self._record, self._warn_jump)
+                           self._record, self._warn_jump,
+                           config.criteria.break_at == "peak")
         self.last_iter = -1
         self.wall_time = {"read": 0.0, "replace": 0.0}
 
@@ -263,9 +266,8 @@ class Controller:
                 self.damping.add(progeny.ids)
                 self.schedule.saw_speed(max((O.bodies[i].state.vel.norm() for i in progeny.ids),
                                             default=0.0))
-                if progeny.smallest_radius is not None:
-                    new_dt = min(new_dt, self.time_step.for_fragments(
-                        progeny.smallest_radius, O.bodies[progeny.ids[0]].material))
+                for radius, material in progeny.smallest:
+                    new_dt = min(new_dt, self.time_step.for_fragments(radius, material))
             self._record("breakage", bid, **event)
         self.time_step.lower(new_dt, self.reader.bodies_in_contact)
         self.wall_time["replace"] += time.perf_counter() - t0
@@ -282,10 +284,15 @@ class Controller:
 
     def finish(self):
         """Close every open stressing event as if its body had unloaded (damage with the event's
-        largest energy), for runs stopped once the loading is over. Returns how many."""
+        largest energy; break_at="peak": a body past its threshold breaks), for runs stopped once
+        the loading is over. Returns how many."""
         state = self.state
-        event_max = state.table.columns["event_max"]
-        closed = 0
+        c = state.table.columns
+        event_max = c["event_max"]
+        cracked = sorted(i for i in state.open_events if i in state.tracked and c["cracked"][i])
+        if cracked:
+            self._break_all([(i, float(event_max[i]), None) for i in cracked])
+        closed = len(cracked)
         for bid in list(state.open_events):
             if bid in state.tracked and event_max[bid] > 0.0:
                 self.judge.close_event(bid)

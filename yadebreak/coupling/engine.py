@@ -8,7 +8,7 @@ from pathlib import Path
 from .yade_api import O, find_engine, wrapper
 from .config import AttachError, Config
 from .controller import Controller
-from .scene_materials import breakable_spheres, resolve
+from .scene_materials import breakable_spheres, dummy_materials, resolve
 from .state import BREAKABLE, BodyRow, EngineState
 from .stepping import smallest_rayleigh_time
 
@@ -51,6 +51,7 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     if not any(isinstance(f, wrapper.Law2_ScGeom_MindlinPhys_Mindlin) for f in laws):
         raise AttachError("the InteractionLoop has no Law2_ScGeom_MindlinPhys_Mindlin: yadebreak "
                           "reads YADE's Hertz-Mindlin forces (use add_materials() for the Ip2)")
+    dummy_materials(materials, config.replacement.dummy_stiffness, engines[loop_idx])
     scene_materials = resolve(materials, config.criteria.kappa, config.criteria.emax_ratio)
     ctl = Controller(label, config, scene_materials, materials)
     ctl.register(breakable_spheres(scene_materials.label_by_id))

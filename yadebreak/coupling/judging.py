@@ -51,8 +51,9 @@ class Judge:
     """Judges the bodies a read found loaded (or with an open event)."""
 
     def __init__(self, state, criterion_of, reader, energy_factor, pausing, fast_tolerance,
-                 record, warn_jump):
+                 record, warn_jump, at_peak=False):
         self.state = state
+        self.at_peak = at_peak                    # break_at="peak"
         self.criterion_of = criterion_of          # material index -> criterion
         self.reader = reader                      # contacts.ContactReader
         self.energy_factor = energy_factor        # fragments_energy_factor
@@ -103,6 +104,12 @@ class Judge:
                 limits.append(steps_allowed(self.fast_tolerance, threshold, level, rise, interval))
             c["specific_energy"][i] = specific
             before = c["event_max"][i]
+            if self.at_peak and (breaks or c["cracked"][i]):
+                breaks = e <= before             # the event's peak has passed: break now
+                if not breaks:                   # still loading: the peak is ahead
+                    c["cracked"][i] = 1
+                    jump = 0.0
+                e = max(e, before)
             if breaks:
                 need[k] = BREAK
             elif e > before:
@@ -135,7 +142,14 @@ class Judge:
             limits = steps_allowed(self.fast_tolerance, v.threshold[r], v.level[r], v.rise[r],
                                    interval).tolist()
         event_max = c["event_max"][ids]
-        grows = active & ~v.breaks & (ek > event_max)
+        breaks = v.breaks
+        if self.at_peak:
+            crossed = active & (breaks | (c["cracked"][ids] > 0))
+            breaks = crossed & (ek <= event_max)         # the event's peak has passed
+            c["cracked"][ids[crossed & ~breaks]] = 1     # still loading: the peak is ahead
+            ek = np.where(breaks, np.maximum(ek, event_max), ek)
+            v.jump = np.where(crossed, 0.0, v.jump)
+        grows = active & ~breaks & (ek > event_max)
         c["specific_energy"][ids[active]] = specific[active]
         c["event_max"][ids[grows]] = ek[grows]
         c["event_partner"][ids[grows]] = [loading.strongest.get(i, NO_PARTNER)[3]
@@ -144,7 +158,7 @@ class Judge:
         c["specific_energy"][ids[paused]] = 0.0
         need = np.full(n, NOTHING, np.int8)
         for what, mask in ((CLOSE_IF_UNLOADED, active & (event_max > 0.0)), (OPEN, grows),
-                           (BREAK, active & v.breaks), (PAUSE, paused), (FORGET, ~known)):
+                           (BREAK, active & breaks), (PAUSE, paused), (FORGET, ~known)):
             need[mask] = what
         return Plan(need.tolist(), v.order.tolist(), ek.tolist(), v.jump.tolist(),
                     v.threshold.tolist(), limits)

@@ -18,14 +18,15 @@ from .state import BREAKABLE, DUMMY, UNBREAKABLE
 @dataclass
 class Progeny:
     """What a replacement made: fragment ids (spheres in the scene), the family's t10' (%), the
-    largest fragment speed beyond the parent's rigid field (m/s), the smallest fragment radius (m,
-    None if every fragment went to the ledger), and the energy audit (J): kinetic and elastic
-    energy of the parent just before, of the progeny just after (see Replacer.replace)."""
+    largest fragment speed beyond the parent's rigid field (m/s), the smallest fragment of each
+    YADE material among them as [(radius (m), material)] (empty if every fragment went to the
+    ledger; what the time step needs), and the energy audit (J): kinetic and elastic energy of
+    the parent just before, of the progeny just after (see Replacer.replace)."""
 
     ids: list
     family_t10: float
     speed_excess: float
-    smallest_radius: float | None
+    smallest: list
     audit: dict
 
 
@@ -79,7 +80,7 @@ class Replacer:
     """Replaces broken spheres; one per engine."""
 
     def __init__(self, options, table, rng, criteria, families, zeroing, reader, ledger,
-                 pause_steps, damped):
+                 pause_steps, damped, dummy_material=None):
         self.options = options         # config.Replacement
         self.table = table
         self.rng = rng
@@ -90,6 +91,7 @@ class Replacer:
         self.ledger = ledger
         self.pause_steps = pause_steps  # material label -> steps
         self.damped = damped           # labels whose fragments start damped (global damping)
+        self.dummy_material = dummy_material or {}     # label -> softer YADE material (option)
 
     def replace(self, bid, t10, direction, dmin):
         """Erase body `bid` and insert its progeny for t10' (%), coarse fragments across
@@ -126,9 +128,11 @@ class Replacer:
                                     + inertias.sum() * spin @ spin)
         radii, centers, masses, vel = radii[keep], centers[keep], masses[keep], vel[keep]
         damped = (label in self.damped) if self.damped else None
-        new = [_sphere_body(material, c, r, m, v, spin, damped)
-               for c, r, m, v in zip(centers.tolist(), radii.tolist(), masses.tolist(),
-                                     vel.tolist())]
+        soft = self.dummy_material.get(label, material)
+        kinds = [soft if d else material for d in fam.is_dummy[keep].tolist()]
+        new = [_sphere_body(k, c, r, m, v, spin, damped)
+               for k, c, r, m, v in zip(kinds, centers.tolist(), radii.tolist(), masses.tolist(),
+                                        vel.tolist())]
         ids = list(O.bodies.append(new))
         self._new_rows(ids, label, fam.is_dummy[keep], radii, masses, t10, 2.0 * radius,
                        int(self.table.columns["generation"][bid]) + 1, dmin)
@@ -145,7 +149,11 @@ class Replacer:
                  "elastic_energy_before": float(elastic_before),
                  "kinetic_energy_after": kinetic_after,
                  "elastic_energy_after": elastic_after}
-        return Progeny(ids, fam.t10, speed_excess, float(radii.min()) if ids else None, audit)
+        smallest = {}
+        for r, k in zip(radii.tolist(), kinds):
+            if k.id not in smallest or r < smallest[k.id][0]:
+                smallest[k.id] = (r, k)
+        return Progeny(ids, fam.t10, speed_excess, list(smallest.values()), audit)
 
     def _new_rows(self, ids, label, is_dummy, radii, masses, t10, parent_size, generation, dmin):
         """The fragments' state: dummy, unbreakable (its own progeny would be finer than dmin)

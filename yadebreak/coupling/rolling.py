@@ -111,6 +111,20 @@ def on_step(label):
     part()
 
 
+def share_pairs(parent, alias):
+    """Material `alias` (a copy of `parent`, e.g. the dummies' softer one) gets `parent`'s
+    rolling friction in every part of this process and in the settings stored with the scene."""
+    for label, part in _PARTS.items():
+        if _TAG + label not in O.tags.keys():
+            continue                      # a part of an earlier scene of this process
+        for (a, b), mu in list(part.mu.items()):
+            if parent in (a, b):
+                other = b if a == parent else a
+                for pair in ((alias, other),) + (((alias, alias),) if other == parent else ()):
+                    part.mu[(min(pair), max(pair))] = mu
+        O.tags[_TAG + label] = json.dumps(part.to_dict())
+
+
 def forget():
     """Drop this process's parts: the next step rebuilds them from O.tags (after O.load)."""
     _PARTS.clear()

@@ -11,6 +11,7 @@ from yadebreak.model.materials import Material, MaterialError, load_material
 from .yade_api import O, wrapper
 from .config import AttachError
 from .criteria import criterion_for
+from .rolling import share_pairs as share_rolling_pairs
 
 
 def _frict_material(mat: Material, label: str, stiffness_scale: float = 1.0):
@@ -96,6 +97,60 @@ def rolling_friction(labels, overrides=None):
     return by_ids, named
 
 
+#: label of the YADE material of a breakable material's dummy spheres: "<label>_dummy"
+DUMMY_SUFFIX = "_dummy"
+
+
+def dummy_materials(labels, factor, loop):
+    """{breakable label: the YADE material of its dummy spheres} when `factor` < 1: a copy of the
+    label's material with its Young's modulus times `factor`, labelled "<label>_dummy", made once
+    per scene (a loaded scene has it already). The paper: the dummies "represent the fines, they
+    can also be considered to be more deformable ... hence a lower value of stiffness may be
+    used". Every pair table keyed by material ids gives it its parent's rows (the Ip2's
+    MatchMakers in `loop`, the InteractionLoop; the rolling friction parts), so that a dummy
+    differs from its parent in stiffness only. factor 1: {} (dummies keep the parent's)."""
+    if factor == 1.0:
+        return {}
+    by_label = {m.label: m for m in O.materials}
+    out = {}
+    for label in labels:
+        mat = by_label.get(label + DUMMY_SUFFIX)
+        if mat is None:
+            parent = by_label[label]
+            mat = type(parent)(**{k: v for k, v in parent.dict().items() if k not in ("id", "label")})
+            mat.young = parent.young * factor
+            mat.label = label + DUMMY_SUFFIX
+            check_physical(mat, f"dummy_stiffness = {factor:g} of material '{label}'")
+            O.materials.append(mat)
+            _share_pairs(loop, parent.id, mat.id)
+            share_rolling_pairs(parent.id, mat.id)
+        out[label] = mat
+    return out
+
+
+def _aliased(rows, parent, alias):
+    """The rows (a, b, value) of a pair table that a material `alias` of `parent` adds."""
+    new = []
+    for a, b, value in rows:
+        a, b = int(a), int(b)
+        if a == parent and b == parent:
+            new += [(alias, parent, value), (alias, alias, value)]
+        elif parent in (a, b):
+            new.append((alias, b if a == parent else a, value))
+    return new
+
+
+def _share_pairs(loop, parent, alias):
+    """Each MatchMaker of the loop's Ip2 functors gets `alias` rows copied from `parent`'s (YADE's
+    MatchMaker cannot be changed in place: it is replaced by an extended one)."""
+    for functor in loop.physDispatcher.functors:
+        for name, value in functor.dict().items():
+            if isinstance(value, wrapper.MatchMaker):
+                rows = [tuple(m) for m in value.matches]
+                setattr(functor, name, wrapper.MatchMaker(
+                    matches=rows + _aliased(rows, parent, alias), algo=value.algo, val=value.val))
+
+
 @dataclasses.dataclass
 class SceneMaterials:
     """The breakable materials by YADE label, and what the engine needs of every YADE material."""
@@ -103,6 +158,7 @@ class SceneMaterials:
     by_label: dict          # YADE label -> Material (breakable)
     label_by_id: dict       # YADE material id -> label, for breakable materials
     stiffness_by_id: dict   # YADE material id -> Hertz stiffness Y / (1 - nu^2) (Pa; inf if rigid)
+    dummy_by_label: dict    # breakable label -> YADE material of its softer dummies (if made)
 
 
 def resolve(materials, kappa=None, emax_ratio=None):
@@ -130,7 +186,10 @@ def resolve(materials, kappa=None, emax_ratio=None):
                            else float(model.hertz_stiffness(young, getattr(m, "poisson", 0.0))))
         if m.label in by_label:
             label_by_id[m.id] = m.label
-    return SceneMaterials(by_label, label_by_id, stiffness)
+    cut = len(DUMMY_SUFFIX)
+    dummies = {m.label[:-cut]: m for m in O.materials
+               if m.label.endswith(DUMMY_SUFFIX) and m.label[:-cut] in by_label}
+    return SceneMaterials(by_label, label_by_id, stiffness, dummies)
 
 
 def breakable_spheres(label_by_id):

@@ -33,6 +33,7 @@ _COLUMNS = {
     "specific_energy": (np.float64, 0.0),                # Ek'/m at the last read
     "event_max": (np.float64, 0.0),                      # largest Ek' of the open event (J)
     "event_partner": (np.int64, -1),    # the body across the contact that brought most of it
+    "cracked": (np.int8, 0),            # break_at="peak": passed its threshold, breaks at the peak
     "t10": (np.float64, math.nan),      # unbreakable: first would-be t10'; dummy: its event's
     "parent_size": (np.float64, math.nan),               # dummy: the parent's diameter
     "generation": (np.int32, 0),

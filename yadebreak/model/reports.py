@@ -85,7 +85,8 @@ class ImpactTally:
     progeny_mass and marker_mass: mass (kg) passing size x RELATIVE_SIEVES and size / MARKERS
     (every fragment, fines included); resolved_mass: passing size x RELATIVE_SIEVES counting the
     spheres in the scene as they are (no fines: the paper's Fig. 13); masses (kg) of the scenes at
-    their start and end."""
+    their start and end; scene_t10: [broken mass, mass passing size / 10] (kg) of each scene that
+    broke (scenes are independently seeded: their scatter is t10's standard error)."""
     size: float
     particles: int = 0
     first: list = field(default_factory=list)
@@ -99,6 +100,7 @@ class ImpactTally:
     scenes: int = 0
     steps: int = 0
     scenes_at_step_limit: int = 0
+    scene_t10: list = field(default_factory=list)
 
     def __post_init__(self):
         if self.progeny_mass is None:
@@ -118,7 +120,10 @@ class ImpactTally:
                               if i not in broken and i in brk.bodies]
         if broken:
             self.progeny_mass += brk.size_distribution(self.size * RELATIVE_SIEVES).passing_mass
-            self.marker_mass += brk.size_distribution(self.size / np.array(MARKERS)).passing_mass
+            markers = brk.size_distribution(self.size / np.array(MARKERS)).passing_mass
+            self.marker_mass += markers
+            self.scene_t10.append([sum(first[i]["mass"] for i in broken),
+                                   float(markers[MARKERS.index(10.0)])])
             self.resolved_mass += brk.size_distribution(self.size * RELATIVE_SIEVES,
                                                         fines=False).passing_mass
         self.breakage_events += len(brk.breakage_events)
@@ -133,6 +138,7 @@ class ImpactTally:
             setattr(self, name, getattr(self, name) + getattr(other, name))
         self.first += other.first
         self.e_cum_intact += other.e_cum_intact
+        self.scene_t10 += other.scene_t10
         self.progeny_mass = self.progeny_mass + other.progeny_mass
         self.marker_mass = self.marker_mass + other.marker_mass
         self.resolved_mass = self.resolved_mass + other.resolved_mass
@@ -164,6 +170,18 @@ class ImpactTally:
     @property
     def mass_relative_error(self):
         return abs(self.final_mass - self.initial_mass) / self.initial_mass
+
+    @property
+    def t10_standard_error(self):
+        """Standard error (%) of t10 (the ratio of the scenes' passing at size / 10 to their broken
+        mass) from the scatter between scenes: sqrt(n / (n - 1) sum (p_i - t m_i)^2) / sum m_i;
+        None with fewer than two scenes that broke."""
+        n = len(self.scene_t10)
+        if n < 2:
+            return None
+        m, p = np.array(self.scene_t10, dtype=float).T
+        t = p.sum() / m.sum()
+        return float(100.0 * np.sqrt(n / (n - 1) * np.sum((p - t * m) ** 2)) / m.sum())
 
 
 def breakage_result(brk, ids, material, size, specific_energy, partner):
@@ -199,6 +217,7 @@ def breakage_result_of(tally, material, specific_energy, partner):
     markers = 100 * tally.marker_mass / parent_mass
     result.update({
         "t10_simulated": float(markers[MARKERS.index(10.0)]),
+        "t10_standard_error": tally.t10_standard_error,
         "t10_primary_events": float(np.mean([e["t10"] for e in broken])),
         "breakage_events_all_generations": tally.breakage_events,
         "progeny_markers": {f"t{n:g}": {"simulated": float(sim), "model": _t_n(material, t10_model, n)}

@@ -49,6 +49,10 @@ def _options(args, out):
         options["dmin"] = args.dmin
     if args.global_damping > 0:
         options.update(global_damping=args.global_damping, global_damping_time=5e-4)
+    if getattr(args, "break_at", "threshold") != "threshold":
+        options["break_at"] = args.break_at
+    if getattr(args, "dummy_stiffness", 1.0) != 1.0:
+        options["dummy_stiffness"] = args.dummy_stiffness
     if getattr(args, "stiffness_scale", 1.0) != 1.0:
         options["stiffness_scale"] = args.stiffness_scale
     return options

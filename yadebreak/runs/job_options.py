@@ -8,7 +8,7 @@ A bad value stops with one line naming the option, the value, the accepted range
 """
 import os
 
-from yadebreak.tools.options import (checkpointed_run_options, choice, fail, flag, integer,
+from yadebreak.tools.options import (break_at_option, checkpointed_run_options, choice, fail, flag, integer,
                                      material_option, number, numbers, read_period_option,
                                      script_params, size_option, text, time_step_option)
 
@@ -74,7 +74,11 @@ def bed_impact():
                hi=1, hi_open=True),
         choice("dummies", "ledger", ("ledger", "spheres"), "the unresolved fines: a mass ledger, "
                "or dummy spheres (the paper)"),
+        number("dummy_stiffness", 1.0, "-", "Young's modulus of the dummy spheres as a share of "
+               "the ore's (with --dummies spheres; the paper allows a softer fines class)",
+               lo=0, hi=1, lo_open=True),
         read_period_option("fast"),
+        break_at_option(),
         number("max_time", 0.1, "s", "simulated time at which the run stops at the latest", lo=0,
                lo_open=True),
         *checkpointed_run_options(1e-4, "out/bed_impact"),
@@ -82,6 +86,9 @@ def bed_impact():
 
 
 def _check_bed_impact(args):
+    if args.dummy_stiffness != 1.0 and args.dummies != "spheres":
+        fail(f"--dummy-stiffness = {args.dummy_stiffness:g}: needs --dummies spheres (the "
+             "ledger keeps no dummy spheres)")
     if args.packing == "poured" and args.layers < 2:
         fail(f"--packing = poured: must be with --layers >= 2 (got {args.layers}); a monolayer "
              "is laid as a lattice")
@@ -113,6 +120,7 @@ def ball_mill():
         number("dmin", 0.0, "m", "smallest resolved fragment; finer progeny goes to the ledger "
                "(0: --size / 3)", lo=0),
         read_period_option("fast"),
+        break_at_option(),
         flag("breakage", True, "0: the spectra run: nothing breaks or is damaged, every stressing "
              "event of the ore is recorded (spectra.csv, for python3 -m yadebreak grind)"),
         integer("seed", 1, "random seed", lo=0),

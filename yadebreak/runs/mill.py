@@ -219,6 +219,8 @@ def _options(args, out):
                    read_period=read_period, event_log=str(out / "events.jsonl"),
                    breakage=bool(getattr(args, "breakage", True)))
     options["dmin"] = args.dmin if args.dmin > 0 else args.size / 3.0
+    if getattr(args, "break_at", "threshold") != "threshold":
+        options["break_at"] = args.break_at
     return options
 
 

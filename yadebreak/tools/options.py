@@ -274,6 +274,14 @@ def read_period_value(value):
     return value if value in ("auto", "fast", "every_step") else int(value)
 
 
+def break_at_option():
+    """--break-at: when a particle breaks and which energy gives its t10' (attach()'s break_at)."""
+    return choice("break_at", "threshold", ("threshold", "peak"), "when a particle breaks: at "
+                  "the read where its energy first passes its fracture energy (threshold, the "
+                  "paper's) or once its stressing event stops rising, t10' from the event's "
+                  "largest energy (peak)")
+
+
 def time_step_option():
     return number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest "
                   "sphere's Rayleigh time", lo=0, lo_open=True, hi=1)

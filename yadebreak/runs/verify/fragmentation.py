@@ -32,9 +32,13 @@ FAMILY_FLOOR, DMIN_RELATIVE = float(CLASS_SIZES[-1]), 1.0 / 20.0
 
 
 def _options(args, time_step, **more):
-    """The paper's settings, contacts read as --read-period says (and --kappa-successive, an
-    option beyond the paper, when given)."""
+    """The paper's settings, contacts read as --read-period says (and --kappa-successive,
+    --break-at peak and --dummy-stiffness, options beyond the paper, when given)."""
     beyond = {"kappa_successive": args.kappa_successive} if args.kappa_successive else {}
+    if args.break_at != "threshold":
+        beyond["break_at"] = args.break_at
+    if args.dummy_stiffness != 1.0:
+        beyond["dummy_stiffness"] = args.dummy_stiffness
     return paper_options(time_step, read_period=args.read_period, **beyond, **more)
 
 
@@ -113,15 +117,23 @@ def _t10_axes(ax, material, size, results, label, c="k", model_line=True):
         ax.semilogx(grid, material.t10_model(grid, size, load_material("steel")), "-", c=c,
                     label=f"{material.name} {1e3 * size:g} mm: model (Eq. 7)")
     done = [r for r in results if r.get("t10_simulated") is not None]
-    ax.plot([r["specific_energy"] for r in done], [r["t10_simulated"] for r in done], "o",
-            c=c, mfc="none", label=label)
+    ax.errorbar([r["specific_energy"] for r in done], [r["t10_simulated"] for r in done],
+                yerr=[r.get("t10_standard_error") or 0.0 for r in done], fmt="o", c=c,
+                mfc="none", capsize=2, label=label + " (± standard error over the particles)")
     ax.set(xlabel="specific impact energy Ek/mp (J/kg)", ylabel="t10 (%)")
     ax.legend(fontsize=6, loc="upper left")
 
 
 T10_HEADER = ["material", "size (mm)", "test", "Ek/mp (J/kg)", "dt (% RT)", "cs",
-              "global damping", "broken %", "t10 sim (%)", "t10 model (%)", "sim / model",
+              "global damping", "broken %", "t10 sim ± s.e. (%)", "t10 model (%)", "sim / model",
               "breakages", "wall (s)"]
+
+
+def _with_error(value, error):
+    """'t10' or 't10 ± its standard error' (%)."""
+    if value is None:
+        return "-"
+    return f"{value:.2f}" if error is None else f"{value:.2f} ± {error:.2f}"
 
 
 def _t10_row(name, size, r, test="single"):
@@ -131,7 +143,7 @@ def _t10_row(name, size, r, test="single"):
     return [name, f"{1e3 * size:g}", test, f"{r['specific_energy']:g}",
             f"{100 * opts['time_step_fraction']:g}", f"{opts.get('cs', 0.0):g}",
             "file" if gd is None else f"{gd:g}", f"{100 * r['broken_fraction']:.1f}",
-            "-" if sim is None else f"{sim:.2f}", "-" if mod is None else f"{mod:.2f}",
+            _with_error(sim, r.get("t10_standard_error")), "-" if mod is None else f"{mod:.2f}",
             "-" if sim is None or not mod else f"{sim / mod:.2f}",
             r.get("breakage_events_all_generations", 0), f"{r['wall_s']:.0f}"]
 

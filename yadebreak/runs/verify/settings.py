@@ -148,4 +148,8 @@ def settings_text(options, material_names, size, particles, seed, extra="", damp
             + ("" if options.get("replace", True) else ", broken particles not replaced")
             + (f"; beyond the paper: kappa {options['kappa_successive']:g} for fragments"
                if options.get("kappa_successive") else "")
+            + ("; beyond the paper: breakage at the stressing event's peak (t10' of its "
+               "largest energy)" if options.get("break_at") == "peak" else "")
+            + (f"; beyond the paper: dummy spheres {options['dummy_stiffness']:g} times as stiff"
+               if options.get("dummy_stiffness", 1.0) != 1.0 else "")
             + (f"; {extra}" if extra else ""))
