@@ -185,3 +185,6 @@ def test_a_dummy_stiffness_out_of_range_is_refused_in_one_line():
     with pytest.raises(config.AttachError) as err:
         config.Config.from_options(dummy_stiffness=0.0)
     assert "dummy_stiffness = 0.0: accepted (0, 1]" in str(err.value)
+    with pytest.raises(config.AttachError) as err:       # a ledger keeps no dummy spheres
+        config.Config.from_options(dummy_stiffness=0.5, dummies="ledger")
+    assert "dummy_stiffness = 0.5: needs dummies='spheres'" in str(err.value)
