@@ -8,9 +8,10 @@ A bad value stops with one line naming the option, the value, the accepted range
 """
 import os
 
-from yadebreak.tools.options import (break_at_option, checkpointed_run_options, choice, fail, flag, integer,
-                                     material_option, number, numbers, read_period_option,
-                                     script_params, size_option, text, time_step_option)
+from yadebreak.tools.options import (break_at_option, checkpointed_run_options, choice, fail,
+                                     flag, integer, material_option, number, numbers,
+                                     read_period_option, script_params, size_option, text,
+                                     time_step_option)
 
 
 # -- blocks that several jobs share (besides tools.options' material, size, time step, ...) ----

@@ -48,7 +48,7 @@ from pathlib import Path
 
 from yadebreak.model.materials import load_material
 from yadebreak.tools.lifecycle import progress
-from yadebreak.tools.options import integer, number, numbers, text
+from yadebreak.tools.options import break_at_option, integer, number, numbers, text
 from . import fragmentation, probability
 from .report import write_report
 from .settings import PAPER_MATERIALS, Runner, paper_material, probability_energies  # noqa: F401
@@ -86,10 +86,7 @@ PARAMS = [
          "clouds: docs/high_energy.md) or every_step (exact); Figs. 8-11 read every step"),
     number("kappa_successive", 0.0, "-", "Eq. 8's kappa for the fragments' breakage in Figs. "
            "13-19 (an option beyond the paper; 0: the paper's, the parent's kappa 1)", lo=0),
-    text("break_at", "threshold", "when a particle breaks in Figs. 13-19 and which energy gives "
-         "its t10': threshold (the paper: the read where its energy first passes its fracture "
-         "energy) or peak (an option beyond the paper: once its stressing event stops rising, "
-         "t10' from the event's largest energy)"),
+    break_at_option(),
     number("dummy_stiffness", 1.0, "-", "Young's modulus of the dummy spheres in Figs. 13-19 as "
            "a share of the ore's (an option beyond the paper, which allows a softer dummy class; "
            "1: the ore's)", lo=0, hi=1, lo_open=True),
@@ -118,8 +115,6 @@ def verify(args):
         fail(f"--dampings = {args.dampings}: each global damping must be in [0, 1), got {bad}")
     if args.read_period not in ("every_step", "fast"):
         fail(f"--read-period = {args.read_period}: accepted every_step or fast")
-    if args.break_at not in ("threshold", "peak"):
-        fail(f"--break-at = {args.break_at}: accepted threshold or peak")
     args.argv = getattr(args, "argv", None) or sys.argv[2:]
     for name in args.material_list:
         load_material(name)                   # a bad name stops here, before any run
