@@ -527,3 +527,17 @@ def test_a_signalled_bed_run_ends_interrupted_with_a_checkpoint(scene, tmp_path,
                                           coupling.load_checkpoint)   # whole, where it stopped
     assert scene.time == pytest.approx(summary["simulated_time"], rel=1e-12)
     assert scene.iter == summary["steps"] and state["arguments"]["rings"] == 1
+
+
+@pytest.mark.yade
+def test_a_failed_impact_worker_stops_the_run_with_its_last_words(tmp_path):
+    """A scene that fails in a worker process (here a material file that is not there): the
+    run stops with an error that carries the worker's own message, and the
+    events so far stay beside the event log."""
+    from yadebreak import scenes
+    log = tmp_path / "events.jsonl"
+    missing = tmp_path / "no_such_material.toml"
+    with pytest.raises(RuntimeError, match="impact worker .* ended") as failed:
+        scenes.single_impacts(str(missing), 5.5e-3, 20.0, 2, 1, 3, jobs=2, event_log=str(log))
+    assert "no_such_material" in str(failed.value)
+    assert (tmp_path / "events.workers" / "spec.json").exists()

@@ -96,3 +96,30 @@ def test_a_run_waits_for_the_fragments_still_flying_towards_the_plate(scene):
                            or impacts._latest_arrival(0.1 * speed) < 1e-5))
     assert flying == [True, False]
     assert counts[1] > counts[0], counts
+
+
+def test_runs_queued_together_in_a_pool_give_what_they_give_one_by_one(scene):
+    """Two sets of 5.5 mm copper ore impacts (one replacing at two energies, one for the
+    probability only), queued together to two worker processes, the costliest first: every
+    result is the one the runs give one after the other in this process, to the last digit
+    (but the time taken); each set ran once, and the pool is gone after close()."""
+    from yadebreak.runs.verify.settings import Run, Runner, paper_options
+    runs = [Run("copper_ore", 5.5e-3, [700.0, 1500.0], 3, 4,
+                paper_options(0.05, read_period="fast")),
+            Run("copper_ore", 5.5e-3, [400.0], 6, 4, paper_options(0.05, replace=False),
+                per_scene=3)]
+    results = []
+    for jobs in (1, 2):
+        runner = Runner(jobs)
+        try:
+            results.append(runner.run_all(runs))
+            pool = runner._pool
+            assert len(runner.results) == 3
+        finally:
+            runner.close()
+        assert pool is None or not pool.folder
+    timeless = [[[{k: v for k, v in r.items() if k != "wall_s"} for r in run] for run in got]
+                for got in results]
+    assert json.dumps(timeless[0]) == json.dumps(timeless[1])
+    assert results[1][0][1]["breakage_events_all_generations"] > 0
+    assert all(r["wall_s"] > 0 for run in results[1] for r in run)

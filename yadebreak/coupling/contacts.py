@@ -269,27 +269,44 @@ class ContactReader:
         if tracked:
             mask[np.fromiter(tracked, np.int64, len(tracked))] = True
         fresh, restored, delta = self._screen(interactions, bodies, mask, counts, now)
-        physs = self.physs
-        m = len(physs)
-        force = np.fromiter([p.normalForce.norm() for p in physs], float, m)
-        us = fs = None
-        if self.cs > 0.0:
-            us = np.fromiter([p.usTotal.norm() for p in physs], float, m)
-            fs = np.fromiter([p.shearForce.norm() for p in physs], float, m)
         pairs = _RowPairs(self.a, self.b) if (self.inherited or asleep or zeroed) else None
+        update = None                          # every row
+        if asleep:
+            update = ~(pairs.among(asleep) & ~fresh & ~restored)
+        force, us, fs = self._forces(update)
         if self.inherited and fresh.any():
             self._start_here(fresh & pairs.among(self.inherited), delta, force, us, fs)
         self.inherited.clear()                 # read now or gone
         self._erased.clear()
-        update = None                          # every row
-        if asleep:
-            update = ~(pairs.among(asleep) & ~fresh & ~restored)
         hertz = ~pairs.among(zeroed) if zeroed else None
         worked = self._work(delta, force, update, hertz, now, interval)
         if us is not None:
             self._shear_work(us, fs, update)
         self._by_body = None
         return self._loading(mask[self.a], mask[self.b], worked)
+
+    def _forces(self, update):
+        """The normal force (N) of each row, and with cs > 0 its shear displacement (m) and
+        force (N), from YADE for the rows `update` (None: every row). The others are slack
+        zeroed pairs asleep: they keep their numbers from their last read, which nothing uses
+        (they are not updated), and reading them from YADE would cost a microsecond each; the
+        fragment clouds of a cascade are mostly such pairs."""
+        physs = self.physs if update is None else [self.physs[k]
+                                                   for k in np.flatnonzero(update).tolist()]
+        m = len(physs)
+
+        def kept(got, stored):                 # the rows read, the others as they were
+            if update is None:
+                return got
+            out = stored.copy()
+            out[update] = got
+            return out
+        force = kept(np.fromiter([p.normalForce.norm() for p in physs], float, m), self.force)
+        if self.cs <= 0.0:
+            return force, None, None
+        us = kept(np.fromiter([p.usTotal.norm() for p in physs], float, m), self.shear_disp)
+        fs = kept(np.fromiter([p.shearForce.norm() for p in physs], float, m), self.shear_force)
+        return force, us, fs
 
     def _screen(self, interactions, bodies, mask, counts, now):
         """The rows laid out as the contacts of tracked bodies now, without a pass over every

@@ -86,7 +86,8 @@ class ImpactTally:
     (every fragment, fines included); resolved_mass: passing size x RELATIVE_SIEVES counting the
     spheres in the scene as they are (no fines: the paper's Fig. 13); masses (kg) of the scenes at
     their start and end; scene_t10: [broken mass, mass passing size / 10] (kg) of each scene that
-    broke (scenes are independently seeded: their scatter is t10's standard error)."""
+    broke (scenes are independently seeded: their scatter is t10's standard error);
+    scene_wall_s: the wall time (s) of the scenes added up, wherever each ran."""
     size: float
     particles: int = 0
     first: list = field(default_factory=list)
@@ -101,6 +102,7 @@ class ImpactTally:
     steps: int = 0
     scenes_at_step_limit: int = 0
     scene_t10: list = field(default_factory=list)
+    scene_wall_s: float = 0.0
 
     def __post_init__(self):
         if self.progeny_mass is None:
@@ -134,7 +136,7 @@ class ImpactTally:
     def merge(self, other):
         """Add another tally of particles of the same size (another process's scenes)."""
         for name in ("particles", "breakage_events", "initial_mass", "final_mass", "scenes",
-                     "steps", "scenes_at_step_limit"):
+                     "steps", "scenes_at_step_limit", "scene_wall_s"):
             setattr(self, name, getattr(self, name) + getattr(other, name))
         self.first += other.first
         self.e_cum_intact += other.e_cum_intact

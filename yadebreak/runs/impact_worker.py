@@ -1,38 +1,49 @@
-"""One worker of scenes.single_impacts(..., jobs=N), run by it as a YADE script:
+"""One worker of an impact pool (scenes/impact_pool.py), started by it as a YADE script:
 
-    yade -n -x impact_worker.py FOLDER WORKER JOBS
+    yade -n -x impact_worker.py POOL WORKER PACKAGE
 
-runs the scenes WORKER, WORKER + JOBS, WORKER + 2 JOBS, ... of FOLDER/spec.json, appends their
-events (with their scene) to FOLDER/WORKER.jsonl and keeps its tally in FOLDER/WORKER.tally.json,
-rewritten after every scene (the parent reads it for progress lines and merges it at the end).
-Coupling layer: imports yade.
+takes scenes from POOL's queue until POOL/stop appears: for each, {"set": SET, "scene": k}, it
+runs scene k of SET/spec.json (scenes.run_scenes), its events to SET/k.jsonl, then its tally to
+SET/k.tally.json (the parent's sign that the scene is done). PACKAGE is the parent's yadebreak,
+wherever it lives. Coupling layer: imports yade.
 """
 import json
 import os
 import signal
 import sys
+import time
 from pathlib import Path
 
 # Ctrl-C reaches the whole process group: the parent stops the workers itself (and they die with
-# it if it is killed: scenes._in_workers)
+# it if it is killed: impact_pool.ImpactPool._start)
 signal.signal(signal.SIGINT, signal.SIG_IGN)
 
-folder, worker, jobs = Path(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
-spec = json.loads((folder / "spec.json").read_text())
-sys.path.insert(0, spec["package"])             # the parent's yadebreak, wherever it lives
+pool, worker, package = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
+sys.path.insert(0, package)
 
 from yadebreak import scenes  # noqa: E402
+from yadebreak.scenes.impact_pool import claim  # noqa: E402
+
+#: how often an idle worker looks at the queue (s)
+IDLE_S = 0.05
 
 
-def keep(done, total, tally):
-    tmp = folder / f"{worker}.tally.tmp"
+def run_one(task):
+    folder, k = Path(task["set"]), int(task["scene"])
+    spec = json.loads((folder / "spec.json").read_text())
+    tally, _ = scenes.run_scenes(spec, [k], folder / f"{k}.jsonl")
+    tmp = folder / f"{k}.tally.tmp"
     tmp.write_text(json.dumps(tally.to_dict()))
-    os.replace(tmp, folder / f"{worker}.tally.json")
+    os.replace(tmp, folder / f"{k}.tally.json")
 
 
 try:
-    scenes.run_scenes(spec, range(worker, len(spec["counts"]), jobs), folder / f"{worker}.jsonl",
-                      on_scene=keep)
+    while not (pool / "stop").exists():
+        task = claim(pool, worker)
+        if task is None:
+            time.sleep(IDLE_S)
+        else:
+            run_one(task)
 except BaseException:                            # the parent shows this and stops the others
     import traceback
     traceback.print_exc()

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -72,7 +73,7 @@ def scene_seed(seed, scene):
 
 def single_impacts(material, size, speed, particles, per_scene, seed, target="steel",
                    event_log=None, on_scene=None, max_steps=200000, jobs=1,
-                   wait_for_arrivals=False, **options):
+                   wait_for_arrivals=False, pool=None, **options):
     """`particles` particles fired at `speed` (m/s) normally at a plate, `per_scene` at a time in
     independent scenes, each run to its own end (run_until_rebound with its controller).
 
@@ -80,26 +81,38 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     step of the finest fragment of any (200 ab_t10_ore particles of 12 mm at 160 J/kg: 470 s in
     one scene; docs/high_energy.md). The particles are independent either way: nothing touches
     across the 4-diameter spacing during an impact. Scene k is seeded scene_seed(seed, k), so
-    the result does not depend on `jobs`: with jobs > 1 the scenes are shared among that many
-    YADE processes (yadebreak/impact_worker.py), each running every jobs-th scene.
+    the result does not depend on `jobs`: with jobs > 1 (or an impact_pool.ImpactPool `pool`,
+    which a job keeps for all its runs) the scenes are run by YADE worker processes, each taking
+    the next scene when it is free, and their tallies are merged in scene order.
 
     Events go to `event_log` (each with its `scene`), the running scene's to `<log>.scene.jsonl`
-    until it ends (with workers: each worker's to `<log>.workers/<worker>.jsonl`, joined at the
+    until it ends (with workers: each scene's to `<log>.workers/<scene>.jsonl`, joined at the
     end; a failed run leaves them there). on_scene(scenes done, scenes, tally) after each scene
     (progress lines). A scene stops after max_steps at the latest (counted in
     tally.scenes_at_step_limit). `material`: a name or path (workers get it as text). Returns
     (reports.ImpactTally, with the steps of every scene; the last scene's controller, None with
     workers). wait_for_arrivals: see run_until_rebound."""
-    counts = [per_scene] * (particles // per_scene) + ([particles % per_scene]
-                                                        if particles % per_scene else [])
-    spec = {"material": str(material), "size": size, "speed": speed, "seed": seed,
-            "target": target, "max_steps": max_steps, "options": options, "counts": counts,
-            "wait_for_arrivals": wait_for_arrivals}
-    if jobs > 1 and len(counts) > 1:
-        return _in_workers(spec, min(jobs, len(counts)), event_log, on_scene)
+    spec = impact_spec(material, size, speed, particles, per_scene, seed, target, max_steps,
+                       wait_for_arrivals, **options)
+    if pool is None and jobs > 1 and len(spec["counts"]) > 1:
+        from .impact_pool import ImpactPool
+        with ImpactPool(min(jobs, len(spec["counts"]))) as own:
+            return own.collect(own.submit(spec, event_log), on_scene), None
+    if pool is not None:
+        return pool.collect(pool.submit(spec, event_log), on_scene), None
     if event_log is not None:
         Path(event_log).write_text("")
-    return run_scenes(spec, range(len(counts)), event_log, on_scene)
+    return run_scenes(spec, range(len(spec["counts"])), event_log, on_scene)
+
+
+def impact_spec(material, size, speed, particles, per_scene, seed, target="steel",
+                max_steps=200000, wait_for_arrivals=False, **options):
+    """single_impacts' arguments as plain JSON (what a worker process runs scenes from)."""
+    counts = [per_scene] * (particles // per_scene) + ([particles % per_scene]
+                                                        if particles % per_scene else [])
+    return {"material": str(material), "size": size, "speed": speed, "seed": seed,
+            "target": target, "max_steps": max_steps, "options": options, "counts": counts,
+            "wait_for_arrivals": wait_for_arrivals}
 
 
 def run_scenes(spec, which, event_log=None, on_scene=None):
@@ -111,6 +124,7 @@ def run_scenes(spec, which, event_log=None, on_scene=None):
     live = None if log is None else log.with_suffix(".scene.jsonl")
     brk, counts = None, spec["counts"]
     for done, k in enumerate(which, start=1):
+        began = time.perf_counter()
         brk, ids = impact_scene(spec["material"], spec["size"], [spec["speed"]] * counts[k],
                                 target=spec["target"], seed=scene_seed(spec["seed"], k),
                                 event_log=None if live is None else str(live), **spec["options"])
@@ -120,6 +134,7 @@ def run_scenes(spec, which, event_log=None, on_scene=None):
         tally.steps += ran
         tally.scenes_at_step_limit += ran >= spec["max_steps"]
         tally.add(brk, ids, initial_mass)
+        tally.scene_wall_s += time.perf_counter() - began
         if log is not None:
             with open(log, "a") as f:
                 f.writelines(json.dumps({"scene": k, **e}) + "\n" for e in brk.events)
@@ -128,83 +143,6 @@ def run_scenes(spec, which, event_log=None, on_scene=None):
         if on_scene is not None:
             on_scene(done, len(which), tally)
     return tally, brk
-
-
-def _in_workers(spec, jobs, event_log, on_scene):
-    """single_impacts in `jobs` YADE processes; their tallies merged, their logs joined in scene
-    order. A worker that fails stops the others and raises with its last words.
-
-    Why not the sweeps' Dask pool (tools.sweep): a Dask task reports only when it ends, while
-    these workers write their tallies after every scene (the parent's progress lines and the
-    partial results a killed run keeps), and a LocalCluster costs 6-8 s to start on this 2-core
-    machine against 3.5 s for a YADE process (measured with `python3 -m yadebreak sweep`'s
-    connect('local:2') and `yade -n -x /dev/null`). The two share the launch rule: children die
-    with their parent (tools.sweep.die_with_parent)."""
-    import shutil
-    import subprocess
-    import tempfile
-    import time
-    if event_log is None:
-        folder = Path(tempfile.mkdtemp(prefix="yadebreak-impacts-"))
-    else:                                 # beside the log: a failed run leaves its events there
-        folder = Path(event_log).with_suffix(".workers")
-        shutil.rmtree(folder, ignore_errors=True)
-        folder.mkdir(parents=True)
-    spec = {**spec, "package": str(Path(__file__).resolve().parents[2])}
-    (folder / "spec.json").write_text(json.dumps(spec))
-    worker = str(Path(__file__).resolve().parents[1] / "runs" / "impact_worker.py")
-    errors = [open(folder / f"{j}.err", "w") for j in range(jobs)]
-    from yadebreak.tools.sweep import die_with_parent    # a parent killed (even -9) takes them along
-    procs = [subprocess.Popen(["yade", "-n", "-x", worker, str(folder), str(j), str(jobs)],
-                              stdout=subprocess.DEVNULL, stderr=errors[j],
-                              preexec_fn=die_with_parent) for j in range(jobs)]
-    try:
-        reported = 0
-        while True:
-            running = any(p.poll() is None for p in procs)
-            _check_workers(procs, folder)
-            tally = _merged(folder, jobs, spec["size"])
-            if on_scene is not None and tally.scenes > reported:
-                reported = tally.scenes
-                on_scene(reported, len(spec["counts"]), tally)
-            if not running:
-                break
-            time.sleep(0.5)
-        if tally.scenes != len(spec["counts"]):
-            raise RuntimeError(f"impact workers ran {tally.scenes} of {len(spec['counts'])} "
-                               f"scenes; their messages are in {folder}")
-        if event_log is not None:
-            events = [line for j in range(jobs) if (folder / f"{j}.jsonl").exists()
-                      for line in (folder / f"{j}.jsonl").read_text().splitlines()]
-            events.sort(key=lambda line: json.loads(line)["scene"])       # stable: in-scene order
-            Path(event_log).write_text("".join(line + "\n" for line in events))
-        shutil.rmtree(folder)
-        return tally, None
-    finally:
-        for p in procs:
-            if p.poll() is None:
-                p.kill()
-                p.wait()
-        for f in errors:
-            f.close()
-
-
-def _check_workers(procs, folder):
-    """Raise if a worker has failed, with its last words."""
-    failed = [j for j, p in enumerate(procs) if p.poll() not in (None, 0)]
-    if failed:
-        raise RuntimeError(f"impact worker {failed[0]} failed (its events so far in {folder}): "
-                           + (folder / f"{failed[0]}.err").read_text()[-1500:])
-
-
-def _merged(folder, jobs, size):
-    from yadebreak.model.reports import ImpactTally
-    tally = ImpactTally(size)
-    for j in range(jobs):
-        path = folder / f"{j}.tally.json"
-        if path.exists():
-            tally.merge(ImpactTally.from_dict(json.loads(path.read_text())))
-    return tally
 
 
 def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None, wait_for_arrivals=False):

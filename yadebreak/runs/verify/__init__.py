@@ -38,8 +38,9 @@ Figures (--figures, comma-separated):
 Every run is a scenes.single_impacts call (drop weight: scenes.drop_weight_scene and
 run_drop_weight; Fig. 11: scenes.impact_scene and impact_again, in this process); the results are
 model.reports.breakage_result_of dicts, written to <out>/results.json with their settings. YADE
-runs in this process (the coupling makes it importable); --jobs > 1 shares each run's scenes
-among YADE processes.
+runs in this process (the coupling makes it importable); --jobs > 1 runs the scenes in that many
+YADE processes kept for the whole command (scenes.ImpactPool), each figure's runs queued
+together, the costliest first.
 """
 from __future__ import annotations
 
@@ -119,7 +120,10 @@ def verify(args):
     for name in args.material_list:
         load_material(name)                   # a bad name stops here, before any run
     runner = Runner(args.jobs)
-    figures = [make(args, runner, out) for name, make in FIGURES.items() if name in wanted]
+    try:
+        figures = [make(args, runner, out) for name, make in FIGURES.items() if name in wanted]
+    finally:
+        runner.close()
     write_report(out, figures, runner, args, time.time() - began)
     progress(f"wrote {out / 'report.md'} ({time.time() - began:.0f} s)")
     return 0

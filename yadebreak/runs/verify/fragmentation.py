@@ -126,7 +126,7 @@ def _t10_axes(ax, material, size, results, label, c="k", model_line=True):
 
 T10_HEADER = ["material", "size (mm)", "test", "Ek/mp (J/kg)", "dt (% RT)", "cs",
               "global damping", "broken %", "t10 sim ± s.e. (%)", "t10 model (%)", "sim / model",
-              "breakages", "wall (s)"]
+              "breakages", "scenes' time (s)"]
 
 
 def _with_error(value, error):
@@ -187,10 +187,10 @@ def figure_t10(args, runner, out):
     plt = report.plt_module()
     fig, ax = plt.subplots(figsize=(7.5, 5.2))
     rows, checks = [], []
-    for k, (name, size) in enumerate(cases):
+    by_case = runner.run_all([Run(name, size, energies, n, args.seed,
+                                  _with_file_damping(options, name)) for name, size in cases])
+    for k, ((name, size), results) in enumerate(zip(cases, by_case)):
         mat = paper_material(name)
-        results = runner.run(Run(name, size, energies, n, args.seed,
-                                 _with_file_damping(options, name)))
         _t10_axes(ax, mat, size, results, f"{mat.name} {1e3 * size:g} mm: simulation", f"C{k}")
         rows += [_t10_row(mat.name, size, r) for r in results]
         checks += [t10_check(mat.name, size, r) for r in results]
@@ -239,8 +239,9 @@ def _sensitivity(args, runner, out, *, title, file, values, options_for, value_t
     energies = _energies(args, SENSITIVITY_ENERGIES)
     n = _particles(args)
     mat = paper_material("copper_ore")
-    by_value = {v: runner.run(Run("copper_ore", FRAGMENT_SIZE, energies, n, args.seed,
-                                  options_for(v), test=test)) for v in values}
+    by_value = dict(zip(values, runner.run_all([Run("copper_ore", FRAGMENT_SIZE, energies, n,
+                                                    args.seed, options_for(v), test=test)
+                                                for v in values])))
     plt = report.plt_module()
     fig, axes = plt.subplots(1, 2, figsize=(13, 5.2))
     for k, (v, results) in enumerate(by_value.items()):

@@ -89,14 +89,16 @@ def figure_probability(args, runner, out):
     levels = QUICK_LEVELS if args.quick else PROBABILITY_LEVELS
     n = _particles(args)
     options = _options(args)
-    single, dropped = {}, {}
+    runs = []
     for name in args.material_list:
-        mat = paper_material(name)
-        energies = probability_energies(mat, PROBABILITY_SIZE, levels, steel)
-        single[name] = runner.run(Run(name, PROBABILITY_SIZE, energies, n, args.seed, options,
-                                      per_scene=min(n, 50)))
-        dropped[name] = runner.run(Run(name, PROBABILITY_SIZE, energies, n, args.seed, options,
-                                       test="drop_weight"))
+        energies = probability_energies(paper_material(name), PROBABILITY_SIZE, levels, steel)
+        runs += [Run(name, PROBABILITY_SIZE, energies, n, args.seed, options,
+                     per_scene=min(n, 50)),
+                 Run(name, PROBABILITY_SIZE, energies, n, args.seed, options,
+                     test="drop_weight")]
+    results = runner.run_all(runs)
+    single = dict(zip(args.material_list, results[0::2]))
+    dropped = dict(zip(args.material_list, results[1::2]))
     plt = report.plt_module()
     fig, ax = plt.subplots(figsize=(10, 5.2))
     rows = []
@@ -179,13 +181,14 @@ def figure_targets(args, runner, out):
     levels = (0.5,) if args.quick else PROBABILITY_LEVELS
     n, options = _particles(args), _options(args)
     mat = paper_material(COPPER_ORE)
-    series = []
-    for label, target, seed_offset in fig9_targets(out):
-        partner = load_material(target)
-        energies = probability_energies(mat, PROBABILITY_SIZE, levels, partner)
-        series.append((label, partner, runner.run(Run(
-            COPPER_ORE, PROBABILITY_SIZE, energies, n, args.seed + seed_offset, options,
-            per_scene=min(n, 50), target=target))))
+    targets = [(label, target, seed_offset, load_material(target))
+               for label, target, seed_offset in fig9_targets(out)]
+    by_target = runner.run_all([Run(
+        COPPER_ORE, PROBABILITY_SIZE, probability_energies(mat, PROBABILITY_SIZE, levels, partner),
+        n, args.seed + seed_offset, options, per_scene=min(n, 50), target=target)
+        for _, target, seed_offset, partner in targets])
+    series = [(label, partner, results)
+              for (label, _, _, partner), results in zip(targets, by_target)]
     plt = report.plt_module()
     fig, ax = plt.subplots(figsize=(10, 5.2))
     rows = []
@@ -236,13 +239,11 @@ def figure_sizes(args, runner, out):
     plt = report.plt_module()
     fig, ax = plt.subplots(figsize=(10, 5.2))
     rows = []
-    for k, size in enumerate(sizes):
-        if args.quick and size == PROBABILITY_SIZE:
-            energies = probability_energies(mat, size, QUICK_LEVELS, steel)   # Fig. 8's runs
-        else:
-            energies = probability_energies(mat, size, levels, steel)
-        results = runner.run(Run(COPPER_ORE, size, energies, n, args.seed, options,
-                                 per_scene=min(n, 50)))
+    runs = [Run(COPPER_ORE, size, probability_energies(
+        mat, size, QUICK_LEVELS if args.quick and size == PROBABILITY_SIZE else levels, steel),
+        n, args.seed, options, per_scene=min(n, 50)) for size in sizes]   # quick 5.5 mm: Fig. 8's
+    for k, (size, run, results) in enumerate(zip(sizes, runs, runner.run_all(runs))):
+        energies = run.energies
         _model_line(ax, mat, energies, size, steel, f"C{k}", f"{1e3 * size:g} mm: model")
         _points(ax, results, "o", f"C{k}", f"{1e3 * size:g} mm: simulation")
         rows += [_row(f"{1e3 * size:g} mm", r) for r in results]

@@ -64,45 +64,94 @@ def paper_options(time_step, **more):
 
 
 class Runner:
-    """Runs impacts once per key (figures share runs) and keeps every result."""
+    """Runs impacts once per key (figures share runs) and keeps every result. With jobs > 1 the
+    single-impact scenes go to one pool of YADE workers kept for the whole command
+    (scenes.ImpactPool); run_all queues several runs at once, the costliest first, so that no
+    worker idles while another ends a run. close() stops the pool."""
 
     def __init__(self, jobs):
         self.jobs = jobs
         self.results = {}
+        self._pool = None
 
     def run(self, run):
-        from yadebreak import scenes
+        return self.run_all([run])[0]
+
+    def run_all(self, runs):
+        """The results of each run (a list per run, one result per energy), run together."""
+        todo = [(run, energy) for run in runs for energy in run.energies
+                if run.key(energy) not in self.results]
+        todo = list({run.key(energy): (run, energy) for run, energy in todo}.values())
+        todo.sort(key=lambda item: -_cost(*item))          # the longest first
+        pooled = [item for item in todo if self.jobs > 1 and item[0].test != "drop_weight"]
+        queued = [(run, energy, self._pool_of().submit(_spec(run, energy)))
+                  for run, energy in pooled]
+        for run, energy in todo:
+            if (run, energy) not in pooled:
+                self._keep(run, energy, _tally_here(run, energy))
+        for run, energy, impact_set in queued:
+            self._keep(run, energy, self._pool.collect(impact_set))
+        return [[self.results[run.key(energy)] for energy in run.energies] for run in runs]
+
+    def close(self):
+        if self._pool is not None:
+            self._pool.close()
+            self._pool = None
+
+    def _pool_of(self):
+        if self._pool is None:
+            from yadebreak import scenes
+            self._pool = scenes.ImpactPool(self.jobs)
+        return self._pool
+
+    def _keep(self, run, energy, tally):
         mat, steel = paper_material(run.material), load_material(run.target)
-        out = []
-        for energy in run.energies:
-            key = run.key(energy)
-            if key not in self.results:
-                began = time.time()
-                if run.test == "drop_weight":
-                    tally = drop_weight_tally(run, energy)
-                else:
-                    tally, _ = scenes.single_impacts(
-                        run.material, run.size, float(np.sqrt(2.0 * energy)), run.particles,
-                        run.per_scene, run.seed, target=run.target, jobs=self.jobs,
-                        wait_for_arrivals=True, **run.options)
-                result = reports.breakage_result_of(tally, mat, energy, steel)
-                if run.options.get("replace") is False:      # no progeny: no t10 to show
-                    for name in ("t10_simulated", "t10_primary_events", "progeny_markers",
-                                 "relative_sizes", "progeny_passing_simulated",
-                                 "progeny_passing_model"):
-                        result.pop(name, None)
-                    result["t10_note"] = "broken particles not replaced (probability only)"
-                else:
-                    result["progeny_passing_resolved"] = reports.resolved_progeny_passing(tally)
-                result.update(steps=tally.steps, scenes_at_step_limit=tally.scenes_at_step_limit,
-                              wall_s=time.time() - began, material=mat.name, size=run.size,
-                              options=run.options, seed=run.seed, test=run.test)
-                self.results[key] = result
-                progress(f"{mat.name} {1e3 * run.size:g} mm {run.test} "
-                         f"{_settings_short(run.options)}: "
-                         f"{reports.result_line(result)} ({result['wall_s']:.0f} s)")
-            out.append(self.results[key])
-        return out
+        result = reports.breakage_result_of(tally, mat, energy, steel)
+        if run.options.get("replace") is False:      # no progeny: no t10 to show
+            for name in ("t10_simulated", "t10_primary_events", "progeny_markers",
+                         "relative_sizes", "progeny_passing_simulated",
+                         "progeny_passing_model"):
+                result.pop(name, None)
+            result["t10_note"] = "broken particles not replaced (probability only)"
+        else:
+            result["progeny_passing_resolved"] = reports.resolved_progeny_passing(tally)
+        # wall_s: the scenes' own (worker seconds), whichever process ran them and whatever ran
+        # beside them
+        result.update(steps=tally.steps, scenes_at_step_limit=tally.scenes_at_step_limit,
+                      wall_s=tally.scene_wall_s, material=mat.name, size=run.size,
+                      options=run.options, seed=run.seed, test=run.test)
+        self.results[run.key(energy)] = result
+        progress(f"{mat.name} {1e3 * run.size:g} mm {run.test} "
+                 f"{_settings_short(run.options)}: "
+                 f"{reports.result_line(result)} ({result['wall_s']:.0f} s)")
+
+
+def _cost(run, energy):
+    """A guess of a run's cost, to start the longest first: breakage cascades grow with the
+    energy, the steps with 1 / time step, the shear share adds breakage; probability runs
+    (nothing replaced) take seconds."""
+    if run.options.get("replace") is False:
+        return 0.0
+    return (energy * run.particles * (1.0 + run.options.get("cs", 0.0))
+            / run.options["time_step_fraction"])
+
+
+def _spec(run, energy):
+    from yadebreak import scenes
+    return scenes.impact_spec(run.material, run.size, float(np.sqrt(2.0 * energy)), run.particles,
+                              run.per_scene, run.seed, target=run.target,
+                              wait_for_arrivals=True, **run.options)
+
+
+def _tally_here(run, energy):
+    """A run in this process: drop weight, or single impacts with jobs 1."""
+    from yadebreak import scenes
+    if run.test == "drop_weight":
+        return drop_weight_tally(run, energy)
+    tally, _ = scenes.single_impacts(run.material, run.size, float(np.sqrt(2.0 * energy)),
+                                     run.particles, run.per_scene, run.seed, target=run.target,
+                                     wait_for_arrivals=True, **run.options)
+    return tally
 
 
 #: simulated time after which a drop-weight scene stops even if a striker still falls (s)
@@ -117,7 +166,9 @@ def drop_weight_tally(run, energy):
                                                   seed=run.seed, **run.options)
     tally = reports.ImpactTally(run.size)
     initial_mass = brk.total_mass()
+    began = time.perf_counter()
     tally.steps, limited = scenes.run_drop_weight(brk, ids, strikers, DROP_WEIGHT_MAX_TIME)
+    tally.scene_wall_s = time.perf_counter() - began
     tally.scenes_at_step_limit = int(limited)
     brk.finish()
     tally.add(brk, ids, initial_mass)
