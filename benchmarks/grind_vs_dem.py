@@ -330,6 +330,31 @@ def _dem_by_class(dem_run, material):
     return out
 
 
+def _feed_energy(run_dir, first_progeny, level=1.0):
+    """How hard a run's feed particles are stressed: the share (%) of their stressing events at or
+    above `level` J/kg (about E50 at the feed size for limestone_weak) in each half of the run's
+    window, and in its second half the share of events whose partner is a progeny sphere (id >=
+    first_progeny) and the share above `level` among those and among the others."""
+    summary_ = json.loads((Path(run_dir) / "summary.json").read_text())
+    t_end, d0 = summary_["simulated_time"], summary_["size"]
+    events = [json.loads(line) for line in open(Path(run_dir) / "events.jsonl")]
+    feed = [e for e in events if e["kind"] in ("damage", "breakage", "stressing")
+            and abs(2.0 * e["radius"] - d0) < 1e-9 * d0
+            and 0.0 <= e["time"] - SETTLE_TIME <= t_end]
+    late = np.array([e["time"] - SETTLE_TIME >= 0.5 * t_end for e in feed])
+    hard = np.array([e["specific_energy"] >= level for e in feed])
+    progeny = np.array([e.get("partner", -1) >= first_progeny for e in feed])
+
+    def percent(flags, among):
+        return 100.0 * flags[among].mean() if among.any() else float("nan")
+
+    return {"feed events >= 1 J/kg, first half %": percent(hard, ~late),
+            "feed events >= 1 J/kg, second half %": percent(hard, late),
+            "second half: progeny partner %": percent(progeny, late),
+            "second half: >= 1 J/kg with a progeny partner %": percent(hard, late & progeny),
+            "second half: >= 1 J/kg with another partner %": percent(hard, late & ~progeny)}
+
+
 def _model_by_class(spectra_run, dem_run, material, sieve):
     """The model side of --by-class over the DEM run's window: at t = 0 the feed's stressing and,
     per family size, the rate (1/s) and median specific energy (J/kg) of stressing past the
@@ -400,7 +425,11 @@ def by_class(spectra_run, dem_run, material, sieve):
         rows = list(csv.reader(f))
     column = [i for i, h in enumerate(rows[0]) if h.startswith("passing_")
               and abs(float(h.split("_")[1][:-2]) * 1e-3 - sieve) < 1e-6][0]
+    first_progeny = dem["bodies_start"]
     return {**_dem_by_class(dem_run, material),
+            **{f"DEM {k}": v for k, v in _feed_energy(dem_run, first_progeny).items()},
+            **{f"spectra run {k}": v for k, v in
+               _feed_energy(spectra_run, first_progeny).items() if "partner" not in k},
             **_model_by_class(spectra_run, dem_run, material, sieve),
             "DEM primary at sieve % (Eq. 10)": to_percent * float(
                 eq10_fines(dem_run, material, [sieve])[0]),
