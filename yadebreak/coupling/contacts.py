@@ -58,12 +58,22 @@ class _RowPairs:
         self.lo, self.hi = np.minimum(a, b), np.maximum(a, b)
         self._codes = self._tuples = None
 
-    def among(self, pairs):
+    def among(self, pairs, within=None):
         """Which rows are pairs of the set `pairs`: each row looked up when the set is the larger
-        (the zeroed pairs of many fragments), else a sorted search over the set's codes."""
+        (the zeroed pairs of many fragments), else a sorted search over the set's codes. With
+        `within` (a mask of rows holding every row of the set), only those rows are looked up."""
         n = len(self.lo)
         if not pairs:
             return np.zeros(n, bool)
+        if within is not None:
+            if self._tuples is None:
+                self._tuples = list(zip(self.lo.tolist(), self.hi.tolist()))
+            rows = np.flatnonzero(within)
+            tuples = self._tuples
+            found = np.zeros(n, bool)
+            found[rows] = np.fromiter(map(pairs.__contains__, [tuples[k] for k in rows.tolist()]),
+                                      bool, len(rows))
+            return found
         if len(pairs) >= n:
             if self._tuples is None:
                 self._tuples = list(zip(self.lo.tolist(), self.hi.tolist()))
@@ -229,6 +239,7 @@ class ContactReader:
         self.geoms, self.physs = geoms, physs          # YADE's objects (None after a restore)
         self._by_body = None                           # see _rows_of
         self._index = None                             # (id1, id2) -> row, from a scalar read
+        self._pairs = None                             # see _row_pairs
         self._incomplete = incomplete          # rows without YADE's objects yet (a restore)
 
     def __len__(self):
@@ -269,21 +280,28 @@ class ContactReader:
         if tracked:
             mask[np.fromiter(tracked, np.int64, len(tracked))] = True
         fresh, restored, delta = self._screen(interactions, bodies, mask, counts, now)
-        pairs = _RowPairs(self.a, self.b) if (self.inherited or asleep or zeroed) else None
+        pairs = self._row_pairs() if (self.inherited or asleep or zeroed) else None
+        in_zeroed = pairs.among(zeroed) if zeroed else None
         update = None                          # every row
-        if asleep:
-            update = ~(pairs.among(asleep) & ~fresh & ~restored)
+        if asleep:                             # pairs asleep are zeroed pairs: look there only
+            update = ~(pairs.among(asleep, within=in_zeroed) & ~fresh & ~restored)
         force, us, fs = self._forces(update)
         if self.inherited and fresh.any():
             self._start_here(fresh & pairs.among(self.inherited), delta, force, us, fs)
         self.inherited.clear()                 # read now or gone
         self._erased.clear()
-        hertz = ~pairs.among(zeroed) if zeroed else None
+        hertz = ~in_zeroed if zeroed else None
         worked = self._work(delta, force, update, hertz, now, interval)
         if us is not None:
             self._shear_work(us, fs, update)
         self._by_body = None
         return self._loading(mask[self.a], mask[self.b], worked)
+
+    def _row_pairs(self):
+        """The rows' _RowPairs, kept until the rows change (most reads keep every row)."""
+        if self._pairs is None:
+            self._pairs = _RowPairs(self.a, self.b)
+        return self._pairs
 
     def _forces(self, update):
         """The normal force (N) of each row, and with cs > 0 its shear displacement (m) and
@@ -638,7 +656,21 @@ class ContactReader:
         energy, with kno as the law uses it (scaled for zeroed pairs)."""
         total = 0.0
         value = self._value
-        for row, side in self._rows_of(body):
+        sides = self._rows_of(body)
+        if self._rows is None and len(sides) > 1:     # the numpy block: which count, at once
+            rows = np.fromiter((r for r, _ in sides), np.int64, len(sides))
+            b = np.fromiter((s for _, s in sides), bool, len(sides))
+            d = self._data
+            overlap = d[_OVERLAP, rows]
+            counted = ((total_work(d[_WORK, rows], d[_SHEAR_WORK, rows], self.cs)
+                        - np.where(b, d[_OFFSET_B, rows], d[_OFFSET_A, rows]) >= self.emin)
+                       & (overlap > 0.0))
+            share = np.where(b, d[_SHARE_B, rows], d[_SHARE_A, rows])
+            for k in np.flatnonzero(counted).tolist():   # the sum in the rows' order, as below
+                total += float(share[k]) * self.law.stored(self.physs[int(rows[k])].kno,
+                                                           float(overlap[k]))
+            return total
+        for row, side in sides:
             offset = value(row, _OFFSET_B if side else _OFFSET_A)
             overlap = value(row, _OVERLAP)
             if self._total(row) - offset >= self.emin and overlap > 0.0:

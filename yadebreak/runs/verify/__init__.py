@@ -39,8 +39,8 @@ Every run is a scenes.single_impacts call (drop weight: scenes.drop_weight_scene
 run_drop_weight; Fig. 11: scenes.impact_scene and impact_again, in this process); the results are
 model.reports.breakage_result_of dicts, written to <out>/results.json with their settings. YADE
 runs in this process (the coupling makes it importable); --jobs > 1 runs the scenes in that many
-YADE processes kept for the whole command (scenes.ImpactPool), each figure's runs queued
-together, the costliest first.
+YADE processes kept for the whole command (scenes.ImpactPool), every figure's runs queued at the
+start, the costliest first.
 """
 from __future__ import annotations
 
@@ -52,7 +52,8 @@ from yadebreak.tools.lifecycle import progress
 from yadebreak.tools.options import break_at_option, integer, number, numbers, text
 from . import fragmentation, probability
 from .report import write_report
-from .settings import PAPER_MATERIALS, Runner, paper_material, probability_energies  # noqa: F401
+from .settings import (PAPER_MATERIALS, Runner, paper_material, plan,  # noqa: F401
+                       probability_energies)
 
 #: figure name -> the function that runs it and returns its report entry, in report order
 FIGURES = {"probability": probability.figure_probability,
@@ -120,8 +121,10 @@ def verify(args):
     for name in args.material_list:
         load_material(name)                   # a bad name stops here, before any run
     runner = Runner(args.jobs)
+    makers = [make for name, make in FIGURES.items() if name in wanted]
     try:
-        figures = [make(args, runner, out) for name, make in FIGURES.items() if name in wanted]
+        runner.queue(plan(makers, args, out))     # every figure's runs, the costliest first
+        figures = [make(args, runner, out) for make in makers]
     finally:
         runner.close()
     write_report(out, figures, runner, args, time.time() - began)

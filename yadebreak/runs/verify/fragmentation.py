@@ -184,11 +184,11 @@ def figure_t10(args, runner, out):
     if not args.quick and "copper_ore" in args.material_list:
         cases.append(("copper_ore", PROBABILITY_SIZE))
     n = _particles(args)
+    by_case = runner.run_all([Run(name, size, energies, n, args.seed,
+                                  _with_file_damping(options, name)) for name, size in cases])
     plt = report.plt_module()
     fig, ax = plt.subplots(figsize=(7.5, 5.2))
     rows, checks = [], []
-    by_case = runner.run_all([Run(name, size, energies, n, args.seed,
-                                  _with_file_damping(options, name)) for name, size in cases])
     for k, ((name, size), results) in enumerate(zip(cases, by_case)):
         mat = paper_material(name)
         _t10_axes(ax, mat, size, results, f"{mat.name} {1e3 * size:g} mm: simulation", f"C{k}")

@@ -236,13 +236,14 @@ def figure_sizes(args, runner, out):
     levels = (0.5,) if args.quick else PROBABILITY_LEVELS
     n, options = _particles(args), _options(args)
     mat = paper_material(COPPER_ORE)
-    plt = report.plt_module()
-    fig, ax = plt.subplots(figsize=(10, 5.2))
-    rows = []
     runs = [Run(COPPER_ORE, size, probability_energies(
         mat, size, QUICK_LEVELS if args.quick and size == PROBABILITY_SIZE else levels, steel),
         n, args.seed, options, per_scene=min(n, 50)) for size in sizes]   # quick 5.5 mm: Fig. 8's
-    for k, (size, run, results) in enumerate(zip(sizes, runs, runner.run_all(runs))):
+    by_size = runner.run_all(runs)
+    plt = report.plt_module()
+    fig, ax = plt.subplots(figsize=(10, 5.2))
+    rows = []
+    for k, (size, run, results) in enumerate(zip(sizes, runs, by_size)):
         energies = run.energies
         _model_line(ax, mat, energies, size, steel, f"C{k}", f"{1e3 * size:g} mm: model")
         _points(ax, results, "o", f"C{k}", f"{1e3 * size:g} mm: simulation")

@@ -66,32 +66,40 @@ def paper_options(time_step, **more):
 class Runner:
     """Runs impacts once per key (figures share runs) and keeps every result. With jobs > 1 the
     single-impact scenes go to one pool of YADE workers kept for the whole command
-    (scenes.ImpactPool); run_all queues several runs at once, the costliest first, so that no
-    worker idles while another ends a run. close() stops the pool."""
+    (scenes.ImpactPool), queued the costliest first: queue() takes every figure's runs at the
+    start (plan() finds them), run_all those of one figure, so that no worker idles while
+    another ends a run. close() stops the pool."""
 
     def __init__(self, jobs):
         self.jobs = jobs
         self.results = {}
         self._pool = None
+        self._queued = {}                      # run key -> its scenes in the pool
 
     def run(self, run):
         return self.run_all([run])[0]
 
     def run_all(self, runs):
         """The results of each run (a list per run, one result per energy), run together."""
-        todo = [(run, energy) for run in runs for energy in run.energies
-                if run.key(energy) not in self.results]
-        todo = list({run.key(energy): (run, energy) for run, energy in todo}.values())
-        todo.sort(key=lambda item: -_cost(*item))          # the longest first
-        pooled = [item for item in todo if self.jobs > 1 and item[0].test != "drop_weight"]
-        queued = [(run, energy, self._pool_of().submit(_spec(run, energy)))
-                  for run, energy in pooled]
-        for run, energy in todo:
-            if (run, energy) not in pooled:
+        self.queue(runs)
+        each = _each(runs)
+        for key, (run, energy) in each.items():  # drop weight, or jobs 1: here, while the pool works
+            if key not in self._queued and key not in self.results:
                 self._keep(run, energy, _tally_here(run, energy))
-        for run, energy, impact_set in queued:
-            self._keep(run, energy, self._pool.collect(impact_set))
+        for key, (run, energy) in each.items():
+            if key in self._queued:
+                self._keep(run, energy, self._pool.collect(self._queued.pop(key)))
         return [[self.results[run.key(energy)] for energy in run.energies] for run in runs]
+
+    def queue(self, runs):
+        """Send the scenes of `runs` to the pool now (with jobs > 1), the costliest first."""
+        if self.jobs <= 1:
+            return
+        todo = [(key, run, energy) for key, (run, energy) in _each(runs).items()
+                if key not in self.results and key not in self._queued
+                and run.test != "drop_weight"]
+        for key, run, energy in sorted(todo, key=lambda item: -_cost(*item[1:])):
+            self._queued[key] = self._pool_of().submit(_spec(run, energy))
 
     def close(self):
         if self._pool is not None:
@@ -124,6 +132,46 @@ class Runner:
         progress(f"{mat.name} {1e3 * run.size:g} mm {run.test} "
                  f"{_settings_short(run.options)}: "
                  f"{reports.result_line(result)} ({result['wall_s']:.0f} s)")
+
+
+class Planner:
+    """Stands for the Runner in a figure's first lines to learn which runs it asks for (plan):
+    run_all and results stop the figure there."""
+
+    class Asked(Exception):
+        pass
+
+    def __init__(self):
+        self.runs = []
+
+    def run(self, run):
+        return self.run_all([run])
+
+    def run_all(self, runs):
+        self.runs += runs
+        raise Planner.Asked
+
+    @property
+    def results(self):                         # a figure run in this process (Fig. 11)
+        raise Planner.Asked
+
+
+def plan(figures, args, out):
+    """The runs the `figures` (functions of (args, runner, out)) will ask for first."""
+    from .report import plt_module
+    planner = Planner()
+    for make in figures:
+        try:
+            make(args, planner, out)
+        except Planner.Asked:
+            pass
+    plt_module().close("all")                  # a figure stopped after its plot was begun
+    return planner.runs
+
+
+def _each(runs):
+    """{key: (run, energy)} of every energy of `runs`, once each."""
+    return {run.key(energy): (run, energy) for run in runs for energy in run.energies}
 
 
 def _cost(run, energy):
