@@ -541,3 +541,8 @@ def test_a_failed_impact_worker_stops_the_run_with_its_last_words(tmp_path):
         scenes.single_impacts(str(missing), 5.5e-3, 20.0, 2, 1, 3, jobs=2, event_log=str(log))
     assert "no_such_material" in str(failed.value)
     assert (tmp_path / "events.workers" / "spec.json").exists()
+    import re
+    import shutil
+    kept = Path(re.search(r"are in (\S+) \(", str(failed.value)).group(1))   # the pool's queue
+    assert (kept / "0.err").exists()
+    shutil.rmtree(kept)

@@ -23,7 +23,8 @@ def test_the_energies_of_figs_8_10_give_the_model_probabilities_asked():
 
 def test_quick_verify_writes_its_report_and_meets_its_checks(scene, tmp_path):
     out = tmp_path / "verify"
-    assert verify.main(["--quick", "1", "--out", str(out)]) == 0
+    # two YADE workers, every figure's runs queued at the start (as the whole command runs)
+    assert verify.main(["--quick", "1", "--jobs", "2", "--out", str(out)]) == 0
     for name in ("report.md", "results.json", "fig08_probability.png", "fig09_targets.png",
                  "fig10_sizes.png", "fig11_repeated.png", "fig13_14_progeny.png", "fig16_t10.png",
                  "fig17_time_step.png", "fig18_cs.png", "fig19_damping.png"):
@@ -123,3 +124,25 @@ def test_runs_queued_together_in_a_pool_give_what_they_give_one_by_one(scene):
     assert json.dumps(timeless[0]) == json.dumps(timeless[1])
     assert results[1][0][1]["breakage_events_all_generations"] > 0
     assert all(r["wall_s"] > 0 for run in results[1] for r in run)
+
+
+def test_the_plan_holds_every_figure_s_first_runs_and_leaves_no_plot_open(tmp_path):
+    """plan() (the runs queued at the start of the command) asks each figure for its runs
+    without running anything: quick Figs. 13-19 come to four fragmentation runs at 1000 J/kg
+    (2 % RT with the file's damping, 5 % RT, damping 0, cs 1), Figs. 8-10 to their probability
+    runs; Fig. 11 runs in this process and is not in it; no figure is left open."""
+    from yadebreak.runs.verify.report import plt_module
+    from yadebreak.runs.verify.settings import plan
+    from yadebreak.tools.options import ScriptParser, add_params, read_params
+    parser = ScriptParser(prog="verify")
+    add_params(parser, verify.PARAMS)
+    args = read_params(parser.parse_args(["--quick", "1", "--out", str(tmp_path)]), verify.PARAMS)
+    args.material_list, args.energy_list = ["copper_ore"], [1000.0]
+    args.damping_list = [0.0, 0.1, 0.3]
+    runs = plan(list(verify.FIGURES[name] for name in verify.DEFAULT_FIGURES), args, tmp_path)
+    keys = {run.key(e) for run in runs for e in run.energies}
+    fragmentation = {k for k in keys if '0.029' in k}
+    assert len(fragmentation) == 4
+    assert all('"replace", false' in k for k in keys - fragmentation)
+    assert {run.size for run in runs} == {2.8e-3, 5.5e-3, 11e-3, 29e-3}      # no 37.5 mm (Fig. 11)
+    assert plt_module().get_fignums() == []

@@ -66,14 +66,19 @@ class ImpactPool:
             os.replace(tmp, self.folder / "queue" / name)   # whole files only: workers list it
         return ImpactSet(folder, spec, event_log)
 
-    def collect(self, impact_set, on_scene=None):
+    def collect(self, impact_set, on_scene=None, on_wait=None, wait_every_s=60.0):
         """Wait for a set's scenes: (reports.ImpactTally of them all, merged in scene order).
-        on_scene(scenes done, scenes, tally so far) as they end. A failed worker stops the pool
-        and raises with its last words."""
+        on_scene(scenes done, scenes, tally so far) as they end; on_wait(scenes started, scenes
+        submitted, all sets counted) every `wait_every_s` of waiting. A failed worker stops the
+        pool and raises with its last words."""
         from yadebreak.model.reports import ImpactTally
         n = len(impact_set.spec["counts"])
         tallies, reported = {}, 0
+        told = time.time()
         while True:
+            if on_wait is not None and time.time() - told >= wait_every_s:
+                told = time.time()
+                on_wait(len(os.listdir(self.folder / "claimed")), self._submitted)
             self._check()
             for k in range(n):
                 path = impact_set.folder / f"{k}.tally.json"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import time
 
 import numpy as np
@@ -88,7 +89,8 @@ class Runner:
                 self._keep(run, energy, _tally_here(run, energy))
         for key, (run, energy) in each.items():
             if key in self._queued:
-                self._keep(run, energy, self._pool.collect(self._queued.pop(key)))
+                self._keep(run, energy, self._pool.collect(self._queued.pop(key),
+                                                           on_wait=_waiting(run, energy)))
         return [[self.results[run.key(energy)] for energy in run.energies] for run in runs]
 
     def queue(self, runs):
@@ -176,12 +178,23 @@ def _each(runs):
 
 def _cost(run, energy):
     """A guess of a run's cost, to start the longest first: breakage cascades grow with the
-    energy, the steps with 1 / time step, the shear share adds breakage; probability runs
-    (nothing replaced) take seconds."""
+    energy, the steps with 1 / time step, the shear share adds breakage. Probability runs
+    (nothing replaced) take seconds: they go first, so that their figures come in minutes."""
     if run.options.get("replace") is False:
-        return 0.0
+        return math.inf
     return (energy * run.particles * (1.0 + run.options.get("cs", 0.0))
             / run.options["time_step_fraction"])
+
+
+def _waiting(run, energy):
+    """A progress line while a run's scenes wait in the pool behind costlier ones."""
+    began = time.time()
+
+    def line(started, submitted):
+        progress(f"waiting for {run.material} {1e3 * run.size:g} mm {energy:g} J/kg: "
+                 f"{started} of {submitted} scenes of the command started "
+                 f"({time.time() - began:.0f} s)")
+    return line
 
 
 def _spec(run, energy):
