@@ -69,8 +69,8 @@ class ImpactPool:
     def collect(self, impact_set, on_scene=None, on_wait=None, wait_every_s=60.0):
         """Wait for a set's scenes: (reports.ImpactTally of them all, merged in scene order).
         on_scene(scenes done, scenes, tally so far) as they end; on_wait(scenes started, scenes
-        submitted, all sets counted) every `wait_every_s` of waiting. A failed worker stops the
-        pool and raises with its last words."""
+        submitted), both counted over every set, every `wait_every_s` of waiting. A failed worker
+        stops the pool and raises with its last words."""
         from yadebreak.model.reports import ImpactTally
         n = len(impact_set.spec["counts"])
         tallies, reported = {}, 0
