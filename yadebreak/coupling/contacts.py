@@ -50,6 +50,10 @@ def pair_codes(id1, id2):
     return (np.asarray(id1, np.int64) << 32) | np.asarray(id2, np.int64)
 
 
+#: stored_share takes a body's rows at once from this many on
+VECTOR_ROWS = 8
+
+
 class _RowPairs:
     """The rows' pairs as (smaller id, larger id), made once per read when asked: as pair_codes
     and as tuples, and which of them are in a set of pairs."""
@@ -657,7 +661,9 @@ class ContactReader:
         total = 0.0
         value = self._value
         sides = self._rows_of(body)
-        if self._rows is None and len(sides) > 1:     # the numpy block: which count, at once
+        # a body of many contacts (a fragment in its cloud): which count, at once from the numpy
+        # block; below VECTOR_ROWS the loop is the cheaper (numpy's cost per call)
+        if self._rows is None and len(sides) >= VECTOR_ROWS:
             rows = np.fromiter((r for r, _ in sides), np.int64, len(sides))
             b = np.fromiter((s for _, s in sides), bool, len(sides))
             d = self._data
