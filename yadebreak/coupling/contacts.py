@@ -70,24 +70,25 @@ class _RowPairs:
         if not pairs:
             return np.zeros(n, bool)
         if within is not None:
-            if self._tuples is None:
-                self._tuples = list(zip(self.lo.tolist(), self.hi.tolist()))
             rows = np.flatnonzero(within)
-            tuples = self._tuples
+            tuples = self._tuple_list()
             found = np.zeros(n, bool)
             found[rows] = np.fromiter(map(pairs.__contains__, [tuples[k] for k in rows.tolist()]),
                                       bool, len(rows))
             return found
         if len(pairs) >= n:
-            if self._tuples is None:
-                self._tuples = list(zip(self.lo.tolist(), self.hi.tolist()))
-            return np.fromiter(map(pairs.__contains__, self._tuples), bool, n)
+            return np.fromiter(map(pairs.__contains__, self._tuple_list()), bool, n)
         if self._codes is None:
             self._codes = pair_codes(self.lo, self.hi)
         ab = np.fromiter(chain.from_iterable(pairs), np.int64, 2 * len(pairs))
         known = np.sort(pair_codes(ab[0::2], ab[1::2]))
         pos = np.minimum(np.searchsorted(known, self._codes), len(known) - 1)
         return known[pos] == self._codes
+
+    def _tuple_list(self):
+        if self._tuples is None:
+            self._tuples = list(zip(self.lo.tolist(), self.hi.tolist()))
+        return self._tuples
 
 
 class HertzMindlinWork:

@@ -94,12 +94,12 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     workers). wait_for_arrivals: see run_until_rebound."""
     spec = impact_spec(material, size, speed, particles, per_scene, seed, target, max_steps,
                        wait_for_arrivals, **options)
-    if pool is None and jobs > 1 and len(spec["counts"]) > 1:
+    if pool is not None:
+        return pool.collect(pool.submit(spec, event_log), on_scene), None
+    if jobs > 1 and len(spec["counts"]) > 1:
         from .impact_pool import ImpactPool
         with ImpactPool(min(jobs, len(spec["counts"]))) as own:
             return own.collect(own.submit(spec, event_log), on_scene), None
-    if pool is not None:
-        return pool.collect(pool.submit(spec, event_log), on_scene), None
     if event_log is not None:
         Path(event_log).write_text("")
     return run_scenes(spec, range(len(spec["counts"])), event_log, on_scene)
