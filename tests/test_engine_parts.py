@@ -329,3 +329,28 @@ def test_break_at_peak_waits_for_the_event_to_stop_rising_and_takes_its_largest_
     assert t10 == pytest.approx(float(model.t10(1.5, cu.A, cu.b_prime, cu.kappa)))
     with pytest.raises(config.AttachError, match="break_at"):
         config.Config.from_options(break_at="late")
+
+
+def test_could_break_asks_for_the_fracture_energy_left_after_what_the_event_counted(scene):
+    """Controller.could_break (a scene's end rule asks it): a breakable body could break if its
+    event's counted Ek'/m plus what it may still get reaches its fracture energy (after damage),
+    an unbreakable fragment until its first would-be breakage, a dummy or a body yadebreak does
+    not know never; Ab-T10 accumulates, so any energy could be the last."""
+    from yadebreak import scenes
+    from yadebreak.coupling.state import DUMMY, UNBREAKABLE
+    brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=[5.0, 5.0, 5.0, 5.0], seed=2)
+    c = brk.bodies.columns
+    energy = c["fracture_energy"][ids].copy()
+    assert brk.could_break(ids, energy).all()
+    assert not brk.could_break(ids, energy * (1 - 1e-9)).any()
+    c["specific_energy"][ids[0]] = 0.5 * energy[0]            # half counted already
+    assert brk.could_break(ids[:1], [0.5 * energy[0]]).all()
+    assert not brk.could_break(ids[:1], [0.49 * energy[0]]).any()
+    c["kind"][ids[1]] = DUMMY                                 # dummies are not tracked
+    brk.state.tracked.discard(ids[1])
+    c["kind"][ids[2]] = UNBREAKABLE                           # still tracked: its first stress
+    assert brk.could_break(ids[1:3], [1e9, energy[2]]).tolist() == [False, True]
+    brk.state.tracked.discard(ids[2])                         # stressed once: its t10' is set
+    assert not brk.could_break([ids[2], 0], [1e9, 1e9]).any()  # 0: the plate
+    ab = criteria.AbT10(load_material("ab_t10_ore"))
+    assert ab.energy_to_break(brk.bodies, np.array(ids)).tolist() == [0.0] * 4

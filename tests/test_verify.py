@@ -26,8 +26,9 @@ def test_quick_verify_writes_its_report_and_meets_its_checks(scene, tmp_path):
     # two YADE workers, every figure's runs queued at the start (as the whole command runs)
     assert verify.main(["--quick", "1", "--jobs", "2", "--out", str(out)]) == 0
     for name in ("report.md", "results.json", "fig08_probability.png", "fig09_targets.png",
-                 "fig10_sizes.png", "fig11_repeated.png", "fig13_14_progeny.png", "fig16_t10.png",
-                 "fig17_time_step.png", "fig18_cs.png", "fig19_damping.png"):
+                 "fig10_sizes.png", "fig11_repeated.png", "fig13_14_progeny.png",
+                 "fig15_drop_weight.png", "fig16_t10.png", "fig17_time_step.png", "fig18_cs.png",
+                 "fig19_damping.png"):
         assert (out / name).stat().st_size > 0, name
     report = (out / "report.md").read_text()
     assert "Settings: 5.5 mm on steel" in report and "Emax/E50 4" in report
@@ -58,15 +59,17 @@ def test_quick_verify_writes_its_report_and_meets_its_checks(scene, tmp_path):
     # finer progeny with damping is not reproduced: docs/high_energy.md, "Global damping")
     by_damping = {r["options"].get("global_damping"): r for r in runs
                   if r["size"] == 29e-3 and r["options"]["time_step_fraction"] == 0.02
-                  and r["options"].get("cs", 0.0) == 0.0}
+                  and r["options"].get("cs", 0.0) == 0.0 and r["test"] == "single"}
     assert set(by_damping) == {0.0, 0.3}
     assert by_damping[0.3]["broken_fraction"] == by_damping[0.0]["broken_fraction"] == 1.0
     assert by_damping[0.3]["t10_primary_events"] == by_damping[0.0]["t10_primary_events"]
     assert all(r["scenes_at_step_limit"] == 0 for r in runs)
     # Figs. 13-19 share runs: 1000 J/kg at 2 % RT with the file's damping (0.3) serves Figs.
-    # 13-14, 16, 17 and 19; then 5 % RT (17), damping 0 (18, 19), cs 1 (18): four runs
+    # 13-14, 16, 17 and 19; then 5 % RT (17), damping 0 (18, 19), cs 1 (18): four runs; and
+    # the drop weight (15), one particle its own scene
     fragmentation = [r for r in runs if r["size"] == 29e-3]
-    assert len(fragmentation) == 4
+    assert sorted(r["test"] for r in fragmentation) == ["drop_weight"] + ["single"] * 4
+    assert [r["particles"] for r in fragmentation if r["test"] == "drop_weight"] == [1]
     for r in fragmentation:
         with_fines = r["progeny_passing_simulated"]
         spheres_only = r["progeny_passing_resolved"]
@@ -80,42 +83,53 @@ def test_quick_verify_writes_its_report_and_meets_its_checks(scene, tmp_path):
 
 def test_a_run_waits_for_the_fragments_still_flying_towards_the_plate(scene):
     """29 mm copper ore at 1000 J/kg, seed 9: the quiet rule alone stops the run with a fragment
-    still heading down faster than 10 % of the impact speed (as at every seed from 1 to 11), after
-    4 breakages; with wait_for_arrivals nothing so fast is left in flight, and it breaks once more
-    (5). The cascade is not cut."""
+    heading down faster than 10 % of the impact speed, with more kinetic energy than its fracture
+    energy, after 4 breakages; with wait_for_arrivals no such fragment is left in flight, and it
+    breaks once more (5). The cascade is not cut. What it leaves flying down faster than that
+    cannot break: 20,000 more steps bring no breakage and no unbreakable fragment stressed past
+    its fracture energy (at most a little damage)."""
     from yadebreak import scenes
     from yadebreak.scenes import impacts
     speed = 2000.0 ** 0.5
     options = dict(seed=9, time_step_fraction=0.02, read_period="every_step", emax_ratio=4.0,
                    global_damping=0.0)
-    counts, flying = [], []
+    counts, pending, events = [], [], 0
     for wait in (False, True):
         brk, ids = scenes.impact_scene("copper_ore", 29e-3, speeds=[speed], **options)
         scenes.run_until_rebound(ids, brk=brk, wait_for_arrivals=wait)
         counts.append(len(brk.breakage_events))
-        flying.append(not (impacts._all_away(0.1 * speed)
-                           or impacts._latest_arrival(0.1 * speed) < 1e-5))
-    assert flying == [True, False]
+        pending.append(impacts._arrival_pending(0.1 * speed, brk))
+        events = len(brk.events)
+    assert pending == [True, False]
     assert counts[1] > counts[0], counts
+    still_down = [b.id for b in scenes.impacts.O.bodies
+                  if b is not None and b.dynamic and b.state.vel[2] < -0.1 * speed]
+    assert still_down          # what an end rule on speed alone would have waited for
+    scenes.impacts.run_steps(20000)
+    later = {e["kind"] for e in brk.events[events:]}
+    assert not later & {"breakage", "unbreakable_stressed"}, brk.events[events:]
 
 
 def test_runs_queued_together_in_a_pool_give_what_they_give_one_by_one(scene):
-    """Two sets of 5.5 mm copper ore impacts (one replacing at two energies, one for the
-    probability only), queued together to two worker processes, the costliest first: every
-    result is the one the runs give one after the other in this process, to the last digit
-    (but the time taken); each set ran once, and the pool is gone after close()."""
+    """Three sets of 5.5 mm copper ore impacts (one replacing at two energies, one for the
+    probability only, and drop-weight tests, each particle its own scene), queued together to
+    two worker processes, the costliest first: every result is the one the runs give one after
+    the other in this process, to the last digit (but the time taken); each set ran once, and
+    the pool is gone after close()."""
     from yadebreak.runs.verify.settings import Run, Runner, paper_options
     runs = [Run("copper_ore", 5.5e-3, [700.0, 1500.0], 3, 4,
                 paper_options(0.05, read_period="fast")),
             Run("copper_ore", 5.5e-3, [400.0], 6, 4, paper_options(0.05, replace=False),
-                per_scene=3)]
+                per_scene=3),
+            Run("copper_ore", 5.5e-3, [1500.0], 2, 4, paper_options(0.05, read_period="fast"),
+                test="drop_weight")]
     results = []
     for jobs in (1, 2):
         runner = Runner(jobs)
         try:
             results.append(runner.run_all(runs))
             pool = runner._pool
-            assert len(runner.results) == 3
+            assert len(runner.results) == 4
         finally:
             runner.close()
         assert pool is None or not pool.folder
@@ -123,13 +137,17 @@ def test_runs_queued_together_in_a_pool_give_what_they_give_one_by_one(scene):
                 for got in results]
     assert json.dumps(timeless[0]) == json.dumps(timeless[1])
     assert results[1][0][1]["breakage_events_all_generations"] > 0
+    drop_weight = results[1][2][0]
+    assert drop_weight["test"] == "drop_weight"
+    assert drop_weight["breakage_events_all_generations"] > 0
     assert all(r["wall_s"] > 0 for run in results[1] for r in run)
 
 
 def test_the_plan_holds_every_figure_s_first_runs_and_leaves_no_plot_open(tmp_path):
     """plan() (the runs queued at the start of the command) asks each figure for its runs
-    without running anything: quick Figs. 13-19 come to four fragmentation runs at 1000 J/kg
-    (2 % RT with the file's damping, 5 % RT, damping 0, cs 1), Figs. 8-10 to their probability
+    without running anything: quick Figs. 13-19 come to five fragmentation runs at 1000 J/kg
+    (2 % RT with the file's damping, 5 % RT, damping 0, cs 1; the drop weight), Figs. 8-10 to
+    their probability
     runs; Fig. 11 runs in this process and is not in it; no figure is left open."""
     from yadebreak.runs.verify.report import plt_module
     from yadebreak.runs.verify.settings import plan
@@ -142,7 +160,7 @@ def test_the_plan_holds_every_figure_s_first_runs_and_leaves_no_plot_open(tmp_pa
     runs = plan(list(verify.FIGURES[name] for name in verify.DEFAULT_FIGURES), args, tmp_path)
     keys = {run.key(e) for run in runs for e in run.energies}
     fragmentation = {k for k in keys if '0.029' in k}
-    assert len(fragmentation) == 4
+    assert len(fragmentation) == 5 and sum('"drop_weight"' in k for k in fragmentation) == 1
     assert all('"replace", false' in k for k in keys - fragmentation)
     assert {run.size for run in runs} == {2.8e-3, 5.5e-3, 11e-3, 29e-3}      # no 37.5 mm (Fig. 11)
     assert plt_module().get_fignums() == []

@@ -135,6 +135,25 @@ class Controller:
         """State of a body as a dict (fracture_energy, damage, kind, specific_energy...)."""
         return self.state.table[body_id].as_dict()
 
+    def could_break(self, ids, more):
+        """Which of the bodies `ids` could break if their stressing event went on to count
+        `more` (J/kg, one per body) than it has now (Ek'/m at the last read), or be stressed past
+        their fracture energy for the first time if they are unbreakable fragments (that sets
+        their t10', hence their fines): tracked bodies whose criterion needs no more
+        (criteria: energy_to_break). Dummies never break. A scene's end rule asks it
+        (scenes.run_until_rebound)."""
+        table, tracked = self.state.table, self.state.tracked
+        c = table.columns
+        ids = np.asarray(ids, np.int64)
+        live = np.fromiter((i in tracked for i in ids.tolist()), bool, len(ids))
+        need = np.full(len(ids), np.inf)
+        materials = c["material"][ids[live]]
+        for m in np.unique(materials).tolist():
+            rows = np.flatnonzero(live)[materials == m]
+            need[rows] = self._criterion_of[m].energy_to_break(table, ids[rows])
+        now = np.where(live, c["specific_energy"][np.where(live, ids, 0)], 0.0)
+        return now + np.asarray(more, float) >= need
+
     def total_mass(self):
         """Mass (kg) of every body yadebreak knows, fragments and ledger fines included."""
         return self.state.total_mass()

@@ -8,6 +8,7 @@ read and write the body columns of state.BodyTable; no yade import.
     breakage(table, i, ek) -> (ratio, t10, extra)     the t10' of a breakage (Eq. 8 or 9.4)
     force(table, i, ratio) -> ek                      a breakage imposed by break_body()
     sample(rng, sizes) -> (fracture energies, extra columns)   state of a new body
+    energy_to_break(table, ids) -> J/kg               the least one event must bring to break them
     event_kind                                        what unload()'s events are logged as
 
 Recording (attach(breakage=False)) wraps a material's criterion: nothing breaks or weakens, every
@@ -83,6 +84,11 @@ class Tavares:
         rise = specific - before
         return specific > threshold, specific, threshold, specific > before, rise, rise
 
+    @staticmethod
+    def energy_to_break(table, ids):
+        """Eq. 1's criterion: an event breaks the body if its Ek'/m passes E (after damage)."""
+        return table.columns["fracture_energy"][ids]
+
     def unload(self, table, i):
         """Eqs. 5-6 with the event's largest Ek' (breakable bodies only)."""
         c = table.columns
@@ -143,6 +149,11 @@ class AbT10:
         c["e_cum"][i], c["e_max"][i], c["e_prev"][i] = cum, top, specific
         threshold = c["fracture_energy"][i]
         return cum > threshold, cum, threshold, specific > before, specific - before, cum - cum_before
+
+    @staticmethod
+    def energy_to_break(table, ids):
+        """No bound: Eq. 9.2 accumulates, so any event may be the one that passes the threshold."""
+        return np.zeros(len(ids))
 
     def unload(self, table, i):
         """Eq. 9.2 at the unloading: e_t = 0 < e_min resets e_max; e_cum keeps the damage."""
@@ -225,6 +236,11 @@ class Recording:
         if isinstance(breaks, np.ndarray):
             return np.zeros_like(breaks), level, threshold, np.zeros_like(rising), rise, jump
         return False, level, threshold, False, rise, jump
+
+    @staticmethod
+    def energy_to_break(table, ids):
+        """Nothing breaks."""
+        return np.full(len(ids), np.inf)
 
     def unload(self, table, i):
         """The event's fields; the body unchanged."""

@@ -8,7 +8,7 @@ poured_bed  beds poured and settled under gravity, and their cache
 """
 from .beds import (BALL_DIAMETER, BALL_MASS, bed_impact_scene,  # noqa: F401
                    hex_bed_positions, hold_release)
-from .impacts import (drop_weight_scene, hertz_engines, impact_again,  # noqa: F401
-                      impact_scene, impact_spec, run_drop_weight, run_scenes,
+from .impacts import (drop_weight_scene, drop_weight_spec, hertz_engines,  # noqa: F401
+                      impact_again, impact_scene, impact_spec, run_drop_weight, run_scenes,
                       run_until_rebound, scene_seed, single_impacts)
 from .impact_pool import ImpactPool  # noqa: F401

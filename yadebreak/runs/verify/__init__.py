@@ -22,8 +22,8 @@ Figures (--figures, comma-separated):
                10-100x cheaper.
   progeny      Figs. 13-14: 29 mm copper ore, single impacts at --energies, the progeny as the
                spheres stand (no fines) and with the fines, against Eq. 10 at Eq. 7's t10.
-  drop_weight  Fig. 15: the same in drop-weight tests (steel striker of 50 particle masses);
-               not run unless asked: 8 minutes more (fragmentation.figure_drop_weight).
+  drop_weight  Fig. 15: the same in drop-weight tests (steel striker of 50 particle masses on
+               a steel anvil), each particle its own scene.
   t10          Fig. 16: t10 against energy for each material at 29 mm (and copper ore at 5.5 mm),
                single impacts on steel (the paper's Fig. 16 is drop-weight; Fig. 15 runs it).
   time_step    Fig. 17: 29 mm copper ore at 300 and 3000 J/kg, 1-5 % of the Rayleigh time.
@@ -33,11 +33,11 @@ Figures (--figures, comma-separated):
                Figures share runs with the same settings (each runs once).
 
 --quick 1: copper ore only, few particles, 2-3 energies (Figs. 9-10: one level, the 50 %; Fig.
-11: 5 impacts, gamma 5 and 10; Figs. 13-19: 2 particles at 1000 J/kg, 2 % RT)
-(tests/test_verify.py; 18 s with --jobs 2). The whole command: docs/verification.md (31 minutes
-with --jobs 2 on a 2-core machine).
-Every run is a scenes.single_impacts call (drop weight: scenes.drop_weight_scene and
-run_drop_weight; Fig. 11: scenes.impact_scene and impact_again, in this process); the results are
+11: 5 impacts, gamma 5 and 10; Figs. 13-19: 2 particles at 1000 J/kg, 2 % RT, 1 in Fig. 15)
+(tests/test_verify.py; 20 s with --jobs 2). The whole command: docs/verification.md (29 minutes
+with --jobs 2 on a quiet 2-core machine).
+Every run is a set of scenes (scenes.run_scenes of an impact_spec or, for the drop weight, a
+drop_weight_spec; Fig. 11: scenes.impact_scene and impact_again, in this process); the results are
 model.reports.breakage_result_of dicts, written to <out>/results.json with their settings. YADE
 runs in this process (the coupling makes it importable); --jobs > 1 runs the scenes in that many
 YADE processes kept for the whole command (scenes.ImpactPool), every figure's runs queued at the
@@ -65,8 +65,8 @@ FIGURES = {"probability": probability.figure_probability,
            "time_step": fragmentation.figure_time_step, "cs": fragmentation.figure_cs,
            "damping": fragmentation.figure_damping}
 
-#: the figures run unless --figures says otherwise (drop_weight: 8 minutes more)
-DEFAULT_FIGURES = [name for name in FIGURES if name != "drop_weight"]
+#: the figures run unless --figures says otherwise: all
+DEFAULT_FIGURES = list(FIGURES)
 
 PARAMS = [
     integer("quick", 0, "1: the quick subset (copper ore, few particles, 2-3 energies; under 3 "

@@ -94,7 +94,7 @@ def figure_probability(args, runner, out):
         energies = probability_energies(paper_material(name), PROBABILITY_SIZE, levels, steel)
         runs += [Run(name, PROBABILITY_SIZE, energies, n, args.seed, options,
                      per_scene=min(n, 50)),
-                 Run(name, PROBABILITY_SIZE, energies, n, args.seed, options,
+                 Run(name, PROBABILITY_SIZE, energies, n, args.seed, options, per_scene=n,
                      test="drop_weight")]
     results = runner.run_all(runs)
     single = dict(zip(args.material_list, results[0::2]))
