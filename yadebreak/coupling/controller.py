@@ -145,13 +145,13 @@ class Controller:
         table, tracked = self.state.table, self.state.tracked
         c = table.columns
         ids = np.asarray(ids, np.int64)
-        live = np.fromiter((i in tracked for i in ids.tolist()), bool, len(ids))
-        need = np.full(len(ids), np.inf)
-        materials = c["material"][ids[live]]
+        rows = np.flatnonzero(np.fromiter((i in tracked for i in ids.tolist()), bool, len(ids)))
+        need, now = np.full(len(ids), np.inf), np.zeros(len(ids))
+        now[rows] = c["specific_energy"][ids[rows]]
+        materials = c["material"][ids[rows]]
         for m in np.unique(materials).tolist():
-            rows = np.flatnonzero(live)[materials == m]
-            need[rows] = self._criterion_of[m].energy_to_break(table, ids[rows])
-        now = np.where(live, c["specific_energy"][np.where(live, ids, 0)], 0.0)
+            of_m = rows[materials == m]
+            need[of_m] = self._criterion_of[m].energy_to_break(table, ids[of_m])
         return now + np.asarray(more, float) >= need
 
     def total_mass(self):

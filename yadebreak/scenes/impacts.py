@@ -227,11 +227,14 @@ def _arrival_pending(slow, brk):
     on a body counts, and what its event has counted: a fragment on the plate with 26 J/kg of
     its own and a dummy behind it broke at 109 J/kg (29 mm copper ore at 300 J/kg, seed 3)."""
     heading = [b for b in O.bodies if b is not None and b.dynamic and b.state.vel[2] < -slow]
+    touching = {b.id: _touching(b.id) for b in heading}
     near = {b.id: b for b in heading}
-    for b in heading:
-        for other in _touching(b.id):
-            near.setdefault(other.id, other)
-    energy = [(_kinetic(b) + sum(_kinetic(o) for o in _touching(i))) / b.state.mass
+    for others in list(touching.values()):
+        near.update((o.id, o) for o in others)
+    for i in near:
+        if i not in touching:
+            touching[i] = _touching(i)
+    energy = [(_kinetic(b) + sum(map(_kinetic, touching[i]))) / b.state.mass
               for i, b in near.items()]
     return bool(near) and bool(brk.could_break(list(near), energy).any())
 
