@@ -37,7 +37,7 @@ endef
 export LINK_PACKAGE
 
 demo: deps
-	yade -n -x scripts/bed_impact.py --out $(OUT)/bed_impact
+	yade -n -x scripts/bed_impact.py --out $(OUT)/bed_impact --overwrite 1
 
 # The model alone (no YADE): breakage probability, t10 and progeny curves of a material.
 model-demo:

@@ -18,5 +18,6 @@ from yadebreak.runs import job_options  # noqa: E402
 args = job_options.read("extremes", __doc__)
 
 from yadebreak.runs import extremes  # noqa: E402
+from yadebreak.tools.lifecycle import run_script  # noqa: E402
 
-sys.exit(extremes.run(args))
+sys.exit(run_script(extremes.run, args))

@@ -142,3 +142,65 @@ def test_energy_jumping_past_the_fracture_energy_warns_once_with_the_remedy(
     message = str(jumps[0].message)
     assert "of the fracture energy" in message and f"reduce {remedy}" in message
     assert f"read every {read_period} step(s)" in message
+
+
+def _unchanged(O):
+    """What attach changes in a scene: a refusal must leave all of it as it was."""
+    return (O.dt, [type(e).__name__ for e in O.engines], len(O.materials),
+            sorted(O.tags.keys()))
+
+
+@pytest.mark.parametrize("event_log, shown", [
+    ("{tmp}", r"event_log = '.*': a folder; accepted: a file path"),
+    ("{tmp}/ro/events.jsonl", r"event_log = '.*/ro/events.jsonl': cannot be written here"),
+])
+def test_a_bad_event_log_is_refused_before_the_scene_changes(scene, tmp_path, event_log, shown):
+    import os
+    import subprocess
+    from yade import O
+    coupling = _scene()
+    before = _unchanged(O)
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    # a read-only folder (root writes through chmod 555: a read-only tmpfs is what refuses it)
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(ro)],
+                             capture_output=True).returncode == 0
+    if "ro" in event_log and not mounted and os.access(ro, os.W_OK):
+        pytest.skip("no read-only folder can be made here")
+    try:
+        with pytest.raises(coupling.AttachError, match=shown):
+            coupling.attach({"ore": "copper_ore"}, event_log=event_log.format(tmp=tmp_path))
+    finally:
+        if mounted:
+            subprocess.run(["umount", str(ro)], check=True)
+    assert _unchanged(O) == before
+
+
+def test_an_event_log_in_a_missing_folder_makes_the_folder(scene, tmp_path):
+    coupling = _scene()
+    path = tmp_path / "a" / "b" / "events.jsonl"
+    coupling.attach({"ore": "copper_ore"}, event_log=str(path))
+    assert path.is_file()
+
+
+def test_materials_not_a_mapping_is_refused_before_the_scene_changes(scene):
+    from yade import O
+    coupling = _scene()
+    before = _unchanged(O)
+    with pytest.raises(coupling.AttachError, match=r"materials = \['copper_ore'\]: accepted a "
+                                                   r"dict \{YADE material label"):
+        coupling.attach(["copper_ore"])
+    assert _unchanged(O) == before
+
+
+def test_a_second_label_over_bodies_another_tracks_is_refused(scene):
+    """Two engines over the same bodies would judge each twice (one broke body 1 while the other
+    recorded a damage event on it)."""
+    from yade import O
+    coupling = _scene()
+    coupling.attach({"ore": "copper_ore"}, label="first")
+    before = _unchanged(O)
+    with pytest.raises(coupling.AttachError, match=r"bodies \[1\] are tracked by the yadebreak "
+                                                   r"engine 'first' already"):
+        coupling.attach({"ore": "copper_ore"}, label="second")
+    assert _unchanged(O) == before

@@ -110,3 +110,40 @@ def test_materials_are_found_from_any_folder_and_a_working_folder_overrides(tmp_
     proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env,
                           capture_output=True, text=True, timeout=60)
     assert proc.stdout.split() == ["granulite", "my_ore"], proc.stderr
+
+
+def test_a_scene_saved_with_o_save_alone_refuses_to_go_on_in_the_same_process(scene, tmp_path):
+    """As in a fresh process: O.save, running on, then O.reset() and O.load() in this process
+    (the controller in memory is the later one's) refuses too."""
+    from yade import O
+    from yadebreak.coupling import AttachError
+    coupling = _scene()
+    coupling.attach({"ore": "copper_ore"})
+    coupling.run_steps(30)
+    O.save(str(tmp_path / "plain.yade.gz"))
+    coupling.run_steps(5)
+    O.reset()
+    O.load(str(tmp_path / "plain.yade.gz"))
+    with pytest.raises(AttachError, match=r"save scenes with yadebreak.save\(path\)"):
+        coupling.controller_of()
+
+
+def test_a_scene_saved_with_yadebreak_save_reloaded_in_the_same_process_goes_on(scene, tmp_path):
+    """The same reload after yadebreak.save: the stored state is taken, events and all, and the
+    stored state names its event log relative to the saved file's folder."""
+    import json
+    from yade import O
+    coupling = _scene()
+    log = tmp_path / "run" / "events.jsonl"
+    brk = coupling.attach({"ore": "copper_ore"}, event_log=str(log))
+    coupling.run_steps(30)
+    coupling.save(tmp_path / "run" / "scene.yade.gz")
+    stored = json.loads(O.tags["yadebreak:yadebreak"])
+    assert stored["event_log"] == {"path": "events.jsonl", "relative_to": "scene file"}
+    assert str(tmp_path) not in O.tags["yadebreak:yadebreak"]
+    coupling.run_steps(5)
+    O.reset()
+    O.load(str(tmp_path / "run" / "scene.yade.gz"))
+    again = coupling.controller_of()
+    assert again is not brk and again.events == brk.events[:len(again.events)]
+    assert again.state.log.path == log

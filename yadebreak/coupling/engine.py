@@ -5,14 +5,16 @@ import json
 import os
 from pathlib import Path
 
-from .yade_api import O, find_engine, wrapper
+from yadebreak.model.materials import MATERIALS_DIR
+from .yade_api import O, current_scene, find_engine, scene_folder, wrapper
 from .config import AttachError, Config
 from .controller import Controller
-from .scene_materials import breakable_spheres, dummy_materials, resolve
+from .scene_materials import breakable_spheres, check_mapping, dummy_materials, resolve
 from .state import BREAKABLE, BodyRow, EngineState
 from .stepping import smallest_rayleigh_time
 
 _ENGINES: dict[str, Controller] = {}
+_SCENE_OF: dict[str, object] = {}          # label -> the scene its controller belongs to
 _TAG = "yadebreak:"
 _SCRIPT_TAG = "yadebreak_script"
 #: YADE's O.dt before anyone sets it: any other value before attach() is the user's
@@ -38,6 +40,8 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     chooses its criterion (breakage.model = "tavares" or "ab_t10"); one scene may mix both.
     """
     config = Config.from_options(seed=seed, **options)
+    found = check_mapping(materials)
+    _check_event_log(config.output.event_log)
     if label in _ENGINES and find_engine(label) is not None:
         raise AttachError(f"yadebreak is already attached to this scene as '{label}': call attach "
                           "once per scene (or give another label)")
@@ -51,30 +55,70 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     if not any(isinstance(f, wrapper.Law2_ScGeom_MindlinPhys_Mindlin) for f in laws):
         raise AttachError("the InteractionLoop has no Law2_ScGeom_MindlinPhys_Mindlin: yadebreak "
                           "reads YADE's Hertz-Mindlin forces (use add_materials() for the Ip2)")
+    label_ids = {m.id: m.label for m in O.materials if m.label in materials}
+    spheres = breakable_spheres(label_ids)
+    _check_not_tracked_elsewhere(label, [s[0] for s in spheres])
+    # every check is done: from here on the scene changes
     dummy_materials(materials, config.replacement.dummy_stiffness, engines[loop_idx])
-    scene_materials = resolve(materials, config.criteria.kappa, config.criteria.emax_ratio)
+    scene_materials = resolve(found, config.criteria.kappa, config.criteria.emax_ratio)
     ctl = Controller(label, config, scene_materials, materials)
-    ctl.register(breakable_spheres(scene_materials.label_by_id))
+    ctl.register(spheres)
     if not len(ctl.bodies):
         ctl._warn_once("empty", "the scene has no breakable body: nothing will break (materials "
                        f"mapped: {sorted(materials)})")
+    ctl.state.log.start()
     ctl.damping.apply_at_attach()
     user_dt = None if O.dt == YADE_DEFAULT_DT else O.dt
     ctl.time_step.at_attach(smallest_rayleigh_time(), user_dt)
-    ctl.state.log.start()
     engines.insert(loop_idx + 1, _runner("on_read", label, label, ctl.period))
     engines.insert(loop_idx, _runner("on_zero", label, label + "_zero", 1, dead=True))
     O.engines = engines
     ctl.last_iter = O.iter - 1
-    _ENGINES[label] = ctl
+    _hold(label, ctl)
     _store(ctl)
     return ctl
+
+
+def _check_event_log(path):
+    """attach(event_log=...): a file that can be written, checked before the scene changes."""
+    if path is None:
+        return
+    target = Path(path).absolute()
+    if target.is_dir():
+        raise AttachError(f"event_log = {path!r}: a folder; accepted: a file path (e.g. "
+                          f"{os.path.join(path, 'events.jsonl')!r}) or None")
+    folder = target.parent
+    while not folder.exists():                 # attach makes the missing folders
+        folder = folder.parent
+    if not folder.is_dir() or not os.access(folder, os.W_OK | os.X_OK) or (
+            target.exists() and not os.access(target, os.W_OK)):
+        raise AttachError(f"event_log = {path!r}: cannot be written here ({folder} is not a "
+                          "writable folder); accepted: a writable file path or None")
+
+
+def _check_not_tracked_elsewhere(label, ids):
+    """One engine per body: a second label over bodies another one tracks would judge and break
+    them twice."""
+    for other, ctl in _ENGINES.items():
+        if other == label or find_engine(other) is None or _SCENE_OF.get(other) != current_scene():
+            continue
+        shared = sorted(set(ids) & set(ctl.bodies))
+        if shared:
+            raise AttachError(f"bodies {shared[:5]}{' ...' if len(shared) > 5 else ''} are "
+                              f"tracked by the yadebreak engine '{other}' already: map each "
+                              "breakable material in one attach() only")
+
+
+def _hold(label, ctl):
+    _ENGINES[label] = ctl
+    _SCENE_OF[label] = current_scene()
 
 
 def detach(label="yadebreak"):
     """Remove the engine `label` from the scene (its PyRunners, its saved state); returns its
     controller, whose events and results stay readable."""
     ctl = _ENGINES.pop(label, None)
+    _SCENE_OF.pop(label, None)
     O.engines = [e for e in O.engines if getattr(e, "label", "") not in (label, label + "_zero")]
     if _TAG + label in O.tags.keys():
         O.tags[_TAG + label] = ""              # O.tags cannot delete a key
@@ -89,17 +133,19 @@ def forget():
     for ctl in _ENGINES.values():
         ctl.close()
     _ENGINES.clear()
+    _SCENE_OF.clear()
 
 
 def controller_of(label="yadebreak"):
     """The controller of engine `label`, restored from the scene when it was loaded (O.load
-    after yadebreak.save) or went back in time."""
+    after yadebreak.save, in this process or another) or went back in time."""
     ctl = _ENGINES.get(label)
-    if ctl is None or O.iter <= ctl.last_iter or O.iter > ctl.last_iter + ctl.period:
+    if (ctl is None or O.iter <= ctl.last_iter or O.iter > ctl.last_iter + ctl.period
+            or _SCENE_OF[label] != current_scene()):
         if ctl is not None:
             ctl.close()
         ctl = _restore(label)
-        _ENGINES[label] = ctl
+        _hold(label, ctl)
     return ctl
 
 
@@ -110,14 +156,30 @@ def _runs(label):
     return [getattr(find_engine(name), "nDone", 0) for name in (label, label + "_zero")]
 
 
-def _store(ctl):
-    """Everything needed to go on after O.load, as JSON in O.tags."""
+def _store(ctl, folder=None):
+    """Everything needed to go on after O.load, as JSON in O.tags. The event log is named
+    relative to `folder`, the saved scene file's (else relative to the working folder): a run
+    folder moved or copied with its log goes on writing its own."""
+    options = ctl.config.as_options()
+    log = options.pop("event_log")
     O.tags[_TAG + ctl.label] = json.dumps({
-        "label": ctl.label, "options": ctl.config.as_options(),
-        "materials": {k: getattr(v, "source", v) for k, v in ctl.material_names.items()},
+        "label": ctl.label, "options": options,
+        "event_log": None if log is None else {
+            "path": os.path.relpath(os.path.abspath(log), folder or os.getcwd()),
+            "relative_to": "working folder" if folder is None else "scene file"},
+        "materials": {k: _material_reference(v) for k, v in ctl.material_names.items()},
         "iter": O.iter, "runs": _runs(ctl.label), "state": ctl.state.to_dict(),
         "contacts": ctl.reader.to_dict(), "zeroed": ctl.zeroing.to_list(),
         "damped_until": ctl.damping.until, "fast": ctl.schedule.to_list()})
+
+
+def _material_reference(material):
+    """How a stored state names a material: as given (a name or a path), a file of the library
+    by its name (its absolute path would tie the scene to this checkout)."""
+    source = Path(str(getattr(material, "source", material)))
+    if source.suffix == ".toml" and source.resolve().parent == MATERIALS_DIR:
+        return source.stem
+    return str(source)
 
 
 def _restore(label):
@@ -129,8 +191,9 @@ def _restore(label):
             f"yadebreak's state in this scene was stored at step {data['iter']} and the scene ran "
             f"on before it was saved: O.save does not store yadebreak's state; save scenes with "
             f"yadebreak.save(path)")
-    config = Config.from_options(**data["options"])
-    scene_materials = resolve(data["materials"], config.criteria.kappa, config.criteria.emax_ratio)
+    config = Config.from_options(**{**data["options"], "event_log": _stored_event_log(data)})
+    scene_materials = resolve(check_mapping(data["materials"]), config.criteria.kappa,
+                              config.criteria.emax_ratio)
     state = EngineState.from_dict(data["state"], config.output.event_log)
     ctl = Controller(label, config, scene_materials, data["materials"], state)
     table = state.table
@@ -151,11 +214,31 @@ def _restore(label):
     return ctl
 
 
+def _stored_event_log(data):
+    """The event log of a stored state, found from where the scene was loaded: relative to the
+    scene file's folder (or the working folder, for a state stored at attach); a state of an
+    earlier version names its log as given, often absolute: a log of that name in the scene
+    file's folder is taken (a run folder carries its log wherever it was moved or copied)."""
+    here = scene_folder()
+    log = data.get("event_log", ())
+    if log is None:
+        return None
+    if log != ():
+        base = here if log["relative_to"] == "scene file" and here else os.getcwd()
+        return os.path.normpath(os.path.join(base, log["path"]))
+    old = data["options"].get("event_log")
+    if old is not None and os.path.isabs(old) and here is not None:
+        return os.path.join(here, os.path.basename(old))
+    return old
+
+
 def save(path):
-    """O.save the scene with the state of every attached engine (kept in O.tags). O.save alone
-    does not store it: after O.load such a scene refuses to go on rather than go on wrongly."""
+    """O.save the scene with the state of every attached engine (kept in O.tags, the event log
+    named relative to the file's folder). O.save alone does not store it: after O.load such a
+    scene refuses to go on rather than go on wrongly."""
+    folder = os.path.dirname(os.path.abspath(str(path)))
     for ctl in _ENGINES.values():
-        _store(ctl)
+        _store(ctl, folder)
     O.save(str(path))
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Mapping
 
 from yadebreak import model
 from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS
@@ -161,23 +162,35 @@ class SceneMaterials:
     dummy_by_label: dict    # breakable label -> YADE material of its softer dummies (if made)
 
 
-def resolve(materials, kappa=None, emax_ratio=None):
-    """Map attach(materials=...) onto the scene's labelled YADE materials, with the options that
-    override the files (Tavares materials only)."""
-    labels = {m.label: m for m in O.materials}
+def check_mapping(materials):
+    """attach(materials=...) checked against the scene before it changes: a {YADE material label:
+    material name, path or Material} whose labels the scene has and whose materials are
+    breakable. Returns {label: Material}."""
+    if not isinstance(materials, Mapping) or not all(isinstance(k, str) for k in materials):
+        raise AttachError(f"materials = {materials!r}: accepted a dict {{YADE material label: "
+                          "material name, .toml path or Material}, e.g. {'ore': 'copper_ore'}")
+    labels = {m.label for m in O.materials}
     unknown = [lab for lab in materials if lab not in labels]
     if unknown:
         raise AttachError(
             f"unknown YADE material label(s) {unknown}: the scene has "
             f"{sorted(l for l in labels if l) or 'no labelled materials'}; give each breakable "
             f"material a label (FrictMat(..., label='ore')) and map it in attach(materials=...)")
-    by_label = {}
+    found = {}
     for lab, name in materials.items():
         mat = _as_material(name)
         if not mat.breakable:
             raise AttachError(f"material '{mat.name}' (label '{lab}') is not breakable: map only "
                               "breakable materials in attach(materials=...)")
-        by_label[lab] = criterion_for(mat).overridden(kappa=kappa, emax_ratio=emax_ratio)
+        found[lab] = mat
+    return found
+
+
+def resolve(materials, kappa=None, emax_ratio=None):
+    """Map the checked {label: Material} (check_mapping) onto the scene's labelled YADE
+    materials, with the options that override the files (Tavares materials only)."""
+    by_label = {lab: criterion_for(mat).overridden(kappa=kappa, emax_ratio=emax_ratio)
+                for lab, mat in materials.items()}
     stiffness, label_by_id = {}, {}
     for m in O.materials:
         check_physical(m, f"YADE material {m.label or m.id!r}")

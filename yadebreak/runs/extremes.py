@@ -23,7 +23,7 @@ from yadebreak import coupling, scenes
 from yadebreak.coupling import add_materials, attach
 from yadebreak.coupling.yade_api import O, utils
 from yadebreak.model.materials import load_material
-from yadebreak.tools.lifecycle import progress
+from yadebreak.tools.lifecycle import mark_finished, progress
 
 SIZE = 5.5e-3
 
@@ -251,6 +251,7 @@ def run(args):
             writer.writerow({k: (";".join(v) if isinstance(v, list) else v) for k, v in r.items()})
     (out / "extremes.json").write_text(json.dumps(rows, indent=2))
     failed = [r["case"] for r in rows if not r["ok"]]
+    mark_finished(out, args)
     progress(f"{len(rows) - len(failed)} of {len(rows)} cases ok in {time.time() - start:.0f} s; "
              f"wrote {out / 'extremes.md'}" + (f"; FAILED: {failed}" if failed else ""))
     return 1 if failed else 0

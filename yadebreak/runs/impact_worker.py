@@ -22,6 +22,7 @@ pool, worker, package = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
 sys.path.insert(0, package)
 
 from yadebreak import scenes  # noqa: E402
+from yadebreak.coupling.yade_api import close_remote_access  # noqa: E402
 from yadebreak.scenes.impact_pool import claim  # noqa: E402
 
 #: how often an idle worker looks at the queue (s)
@@ -37,6 +38,7 @@ def run_one(task):
     os.replace(tmp, folder / f"{k}.tally.json")
 
 
+close_remote_access()          # the launcher's prompt and XMLRPC servers: nobody else may reach a worker
 try:
     while not (pool / "stop").exists():
         task = claim(pool, worker)

@@ -10,8 +10,8 @@ import os
 
 from yadebreak.tools.options import (break_at_option, checkpointed_run_options, choice, fail,
                                      flag, integer, material_option, number, numbers,
-                                     read_period_option, script_params, size_option, text,
-                                     time_step_option)
+                                     overwrite_option, read_period_option, script_params,
+                                     size_option, text, time_step_option)
 
 
 # -- blocks that several jobs share (besides tools.options' material, size, time step, ...) ----
@@ -28,6 +28,7 @@ def laboratory_test(size, middle, out, resume_help, what):
         read_period_option("every_step"),
         text("out", out, "output folder"),
         flag("resume", False, resume_help),
+        overwrite_option(),
         integer("stop_after", 0, f"(tests) end as if killed after this many {what} (0: never)",
                 lo=0, unit=what),
     ]
@@ -222,6 +223,7 @@ def drop_weight():
 def extremes():
     return [
         text("out", "out/extremes", "output folder"),
+        overwrite_option(),
         flag("fast", False, "the test suite's particle counts"),
         text("only", "", "run the cases whose name contains this text ('': all cases)"),
     ]

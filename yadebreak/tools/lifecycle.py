@@ -48,12 +48,14 @@ def run_script(main, *args):
     only the outputs that exist (kept_outputs). The one place where scripts turn exceptions into
     exit codes."""
     from yadebreak.model.materials import MaterialError
+    close_remote_access()
     out = getattr(args[0], "out", None) if args else None
     began = time.time()
     handlers, locked = _catch_signals(), False
     fresh = out is not None and not Path(out).exists()     # made by the lock: gone if unused
     try:
-        locked = out is not None and lock_out(out)
+        left = None if fresh or out is None else run_left_in(out)    # before our own lock
+        locked = out is not None and lock_out(out, lambda: claim_out(out, args[0], left))
         with warnings_shown_once():
             return main(*args)
     except StopRequested:
@@ -86,10 +88,20 @@ def run_script(main, *args):
         _restore_signals(handlers)
         if locked:                       # the run is over (a YADE prompt may follow)
             _LOCKS.pop(str(Path(out).resolve())).close()
-            if fresh and [p.name for p in Path(out).iterdir()] == [LOCK]:
+            if [p.name for p in Path(out).iterdir()] == [LOCK]:
                 (Path(out) / LOCK).unlink()        # refused before writing: leave nothing
-                Path(out).rmdir()
+                if fresh:
+                    Path(out).rmdir()
     fail(message)
+
+
+def close_remote_access():
+    """Under the `yade` launcher (which imports yade.remote to start them): close its Python
+    prompt and XMLRPC servers, which listen on every interface (coupling.yade_api's
+    close_remote_access). Nothing to do under /usr/bin/python3."""
+    if "yade.remote" in sys.modules:
+        from yadebreak.coupling.yade_api import close_remote_access as close
+        close()
 
 
 def _end_interrupted(exc, out, began):
@@ -127,16 +139,20 @@ LOCK = ".yadebreak.lock"
 _LOCKS = {}          # folder -> its open lock file, held while this process lives
 
 
-def lock_out(out):
+def lock_out(out, claim=None):
     """Hold <out>/.yadebreak.lock (until run_script releases it, or this process ends): a second
     run into the same folder is refused (ScriptError, one line naming the first). An flock: the
     kernel releases it when the process ends however it ends (kill -9 included), so a killed run
-    leaves nothing stuck. Creates the folder. True if taken now, False if this process held it
-    already or the file system has no locks."""
+    leaves nothing stuck. Creates the folder. claim(): the run's own check of the folder, made
+    once the lock is held and before the lock file is written (a refusal leaves it as it was).
+    True if taken now, False if this process held it already or the file system has no
+    locks."""
     import fcntl
     out = Path(out)
     key = str(out.resolve())
     if key in _LOCKS:                     # this process holds it already
+        if claim is not None:
+            claim()
         return False
     out.mkdir(parents=True, exist_ok=True)
     f = open(out / LOCK, "a+")
@@ -147,15 +163,61 @@ def lock_out(out):
         holder = f.read().strip()
         f.close()
         if exc.errno not in (errno.EAGAIN, errno.EACCES):   # a file system without locks: run
+            if claim is not None:
+                claim()
             return False
         raise ScriptError(f"--out = {out}: another run is writing there ({holder or 'a process'}"
                           "); wait for it to end or choose another --out") from None
+    try:
+        if claim is not None:
+            claim()
+    except BaseException:
+        f.close()
+        raise
     f.seek(0)
     f.truncate()
     f.write(f"process {os.getpid()}, started {time.strftime('%Y-%m-%d %H:%M:%S')}\n")
     f.flush()
     _LOCKS[key] = f
     return True
+
+
+def run_left_in(out):
+    """What an earlier run left in `out`, in words, or None if it holds none: a finished run
+    (finished.json), an interrupted one that --resume 1 continues (a checkpoint or partial
+    results), or one that ended early without them (a summary.json, or outputs beside the lock
+    that every run leaves; a lock alone is a run killed before it wrote anything)."""
+    out = Path(out)
+    if (out / FINISHED).is_file():
+        return "a finished run (finished.json)"
+    kept = [name for name in (CHECKPOINT, PARTIAL) if (out / name).is_file()]
+    if kept:
+        stamp = time.strftime("%Y-%m-%d %H:%M", time.localtime((out / kept[0]).stat().st_mtime))
+        return f"an interrupted run ({kept[0]} of {stamp})"
+    if (out / "summary.json").is_file():
+        return "a run that ended early and cannot be resumed (summary.json)"
+    if (out / LOCK).is_file() and any(p.name != LOCK for p in out.iterdir()):
+        return "a run that ended early and cannot be resumed (its lock and outputs)"
+    return None
+
+
+def claim_out(out, args, found):
+    """A run about to write into `out`, which held `found` (run_left_in, read before this run
+    took its lock): a new run (no --resume) over an earlier run is refused (ScriptError, one line
+    naming what is there and the two ways on), unless --overwrite 1, which clears the earlier
+    run's markers (its finish marker, checkpoint and partial results: --resume 1 will not find
+    them)."""
+    resume, overwrite = getattr(args, "resume", False), getattr(args, "overwrite", False)
+    if resume and overwrite:
+        raise ScriptError("--resume 1 and --overwrite 1: choose one (continue the run in --out, "
+                          "or start it over)")
+    if resume or found is None:
+        return
+    if not overwrite:
+        raise ScriptError(f"--out = {out} holds {found}: continue it with --resume 1, start it "
+                          "over with --overwrite 1, or choose another --out")
+    for name in (FINISHED, CHECKPOINT, PARTIAL):
+        (Path(out) / name).unlink(missing_ok=True)
 
 
 # -- signals: SIGINT and SIGTERM end a run as 'interrupted' ----------------------------------------
@@ -247,6 +309,7 @@ def stop_point(save=None):
 
 # -- what a run leaves -----------------------------------------------------------------------------
 CHECKPOINT = "checkpoint.yade.gz"
+PARTIAL = "partial.json"
 
 
 def kept_outputs(out, since):
@@ -259,7 +322,7 @@ def kept_outputs(out, since):
     if not out.is_dir():
         return f"nothing was written in {out}"
     since -= 1.0                         # file times lag the clock by up to a tick
-    parts, resumable = [], [n for n in (CHECKPOINT, "partial.json") if (out / n).is_file()]
+    parts, resumable = [], [n for n in (CHECKPOINT, PARTIAL) if (out / n).is_file()]
     summary = out / "summary.json"
     wrote_summary = summary.is_file() and summary.stat().st_mtime >= since
     if wrote_summary:
@@ -406,12 +469,12 @@ def time_left(elapsed_s, done):
 
 
 def resume_arguments(args):
-    """The arguments that decide a run's results (not --resume, --stop-after, --out,
+    """The arguments that decide a run's results (not --resume, --overwrite, --stop-after, --out,
     --checkpoint-every, --vtk-interval, --debug or --jobs): what a resumed run must share with the
     one it continues."""
     return {k: v for k, v in sorted(vars(args).items())
-            if k not in ("resume", "out", "stop_after", "checkpoint_every", "vtk_interval",
-                         "debug", "jobs")}
+            if k not in ("resume", "overwrite", "out", "stop_after", "checkpoint_every",
+                         "vtk_interval", "debug", "jobs")}
 
 
 #: script options added since a checkpoint could have been written, at the value that gives the
@@ -477,7 +540,7 @@ class PartialResults:
         """validate(key, result): raises ValueError (saying why) if a unit's result read back by
         --resume 1 is not one this run could have written (a tampered or foreign file)."""
         self.out = Path(out)
-        self.path = self.out / "partial.json"
+        self.path = self.out / PARTIAL
         self.args = args
         self.done = {}
         if not getattr(args, "resume", False):

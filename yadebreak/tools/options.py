@@ -287,6 +287,12 @@ def time_step_option():
                   "sphere's Rayleigh time", lo=0, lo_open=True, hi=1)
 
 
+def overwrite_option():
+    """--overwrite: a new run into an --out that holds an earlier run (otherwise refused)."""
+    return flag("overwrite", False, "start a new run in an --out that holds an earlier run, "
+                "finished or interrupted (without it such an --out is refused)")
+
+
 def checkpointed_run_options(vtk_interval, out):
     """The options of a scene run with checkpoints (bed, mill, agglomerate): the ParaView frame
     interval (s of simulated time), checkpoints, --resume, --stop-after (tests) and the output
@@ -296,6 +302,7 @@ def checkpointed_run_options(vtk_interval, out):
                "series in <out>/paraview (0: no series)", lo=0),
         number("checkpoint_every", 60.0, "s", "wall time between checkpoints (< 0: none)"),
         flag("resume", False, "continue the run that died in --out from its checkpoint"),
+        overwrite_option(),
         number("stop_after", 0.0, "s", "(tests) end as if killed at this simulated time "
                "(0: never)", lo=0),
         text("out", out, "output folder"),
