@@ -199,6 +199,43 @@ def _one_line(text):
     return lines[0]
 
 
+def _read_only_folder(path):
+    """A read-only tmpfs at `path` (root writes through chmod 555), or None where mount is
+    refused; unmounted by the caller."""
+    import subprocess
+    path.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=64k", "tmpfs", str(path)],
+                          capture_output=True)
+    return path if done.returncode == 0 else None
+
+
+@pytest.mark.parametrize("where", ["a file", "a read-only folder"])
+def test_an_out_that_cannot_be_written_ends_in_one_line_exit_1(tmp_path, capsys, where):
+    import subprocess
+    if where == "a file":
+        out = tmp_path / "summary.txt"
+        out.write_text("a user's file")
+        expected = "NotADirectoryError: [Errno 20] a file, not a folder"
+    else:
+        if _read_only_folder(tmp_path / "ro") is None:
+            pytest.skip("no read-only file system can be mounted here")
+        out = tmp_path / "ro" / "run"
+        expected = "Read-only file system"
+    ran = []
+    try:
+        with pytest.raises(SystemExit) as ended:
+            _run_script(ran.append, argparse.Namespace(out=str(out)))
+    finally:
+        if where != "a file":
+            subprocess.run(["umount", str(tmp_path / "ro")], check=True)
+    assert ended.value.code == 1 and ran == []
+    line = _one_line(capsys.readouterr().err)
+    assert line.startswith(f"[yadebreak] error: --out = {out}: cannot be written (")
+    assert expected in line and line.endswith("); nothing was run")
+    if where == "a file":
+        assert out.read_text() == "a user's file"
+
+
 def test_a_second_run_into_an_out_in_use_is_refused_and_a_killed_one_leaves_no_lock(tmp_path,
                                                                                     capsys):
     holder = subprocess.Popen(

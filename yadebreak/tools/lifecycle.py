@@ -55,7 +55,12 @@ def run_script(main, *args):
     fresh = out is not None and not Path(out).exists()     # made by the lock: gone if unused
     try:
         left = None if fresh or out is None else run_left_in(out)    # before our own lock
-        locked = out is not None and lock_out(out, lambda: claim_out(out, args[0], left))
+        try:
+            locked = out is not None and lock_out(out, lambda: claim_out(out, args[0], left))
+        except OSError as exc:           # a read-only or full disk, --out naming a file
+            print(f"[yadebreak] error: --out = {out}: cannot be written ({error_line(exc)}); "
+                  "nothing was run", file=sys.stderr, flush=True)
+            raise SystemExit(1) from None
         with warnings_shown_once():
             return main(*args)
     except StopRequested:
@@ -149,6 +154,8 @@ def lock_out(out, claim=None):
     locks."""
     import fcntl
     out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, "a file, not a folder", str(out))
     key = str(out.resolve())
     if key in _LOCKS:                     # this process holds it already
         if claim is not None:
