@@ -22,6 +22,7 @@ import json
 import math
 import os
 import re
+import shutil
 import signal
 import socket
 import subprocess
@@ -189,11 +190,14 @@ def table_job(line, table, script, out, yade="yade"):
 
 
 def run_job(argv, folder, env, cwd):
-    """Run one job's command with `env` added, its output into FOLDER/log.txt. Returns
+    """Run one job's command with `env` added, its output into FOLDER/log.txt (FOLDER made anew:
+    the sweep runs a line again only when it is not done). Returns
     {exit_code, wall_s, worker, message}: message is the run's error line (the last '[yadebreak]
     error' line, else its last line) when it failed."""
     folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
+    if folder.exists():           # an earlier attempt of this line (failed or killed): run anew,
+        shutil.rmtree(folder)     # as the script refuses a new run over an earlier one
+    folder.mkdir(parents=True)
     environment = {**os.environ, "OMP_NUM_THREADS": "1", **env}
     start = time.time()
     with open(folder / "log.txt", "w") as log:
