@@ -84,6 +84,25 @@ def test_fast_reads_less_often_where_a_fresh_contact_cannot_bring_much_energy(sc
     assert brk.period >= 5                    # it does read less often than every step
 
 
+@pytest.mark.yade
+def test_fast_follows_the_weakest_present_fracture_energy(scene):
+    """A sub-critical impact weakens the particle (Eqs. 5-6): "fast" then bounds a fresh
+    contact's work by 2 % of the lowered fracture energy, not of the one drawn at attach."""
+    from yadebreak import scenes
+    cu = load_material("copper_ore")
+    brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [30.0], seed=3, read_period="fast")
+    drawn = brk.bodies[ids[0]].fracture_energy
+    scenes.run_until_rebound(ids)
+    weakened = brk.bodies[ids[0]].fracture_energy
+    assert [e["kind"] for e in brk.events] == ["damage"] and weakened < 0.98 * drawn
+
+    def onset(energy):
+        return float(placement.hertz_onset_time(2.75e-3, cu.density, cu.young_modulus,
+                                                cu.poisson_ratio, 1.0, 0.02 * energy))
+    assert brk.reach.get(brk.state.tracked)[0] == pytest.approx(onset(weakened), rel=1e-12)
+    assert onset(weakened) < 0.99 * onset(drawn)           # ~ E^0.4: the two are told apart
+
+
 def _unbreakable_impact(read_period):
     """A 5.5 mm copper ore particle made an unbreakable fragment (whose first stressing past its
     fracture energy, here 300 J/kg, sets the t10' it keeps) fired at 40 m/s on steel: its
