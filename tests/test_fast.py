@@ -69,20 +69,93 @@ def test_fast_wall_impacts_receive_e_m_v2_over_2_within_3_percent(scene):
 
 @pytest.mark.yade
 def test_fast_reads_less_often_where_a_fresh_contact_cannot_bring_much_energy(scene):
-    """At 1 m/s a fresh contact brings the weakest 5.5 mm copper ore particles 2 % of their
-    fracture energy only after several steps (hertz_onset_time): "fast" waits that long."""
+    """At 1 m/s a fresh contact brings a 5.5 mm copper ore particle 2 % of its own fracture
+    energy only after several steps (hertz_onset_time): "fast" waits that long."""
     from yadebreak import coupling, scenes
     from yadebreak.coupling.yade_api import O
-    from yadebreak.coupling.stepping import ONSET_QUANTILE
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=[1.0], read_period="fast")
     cu = load_material("copper_ore")
     onset = placement.hertz_onset_time(2.75e-3, cu.density, cu.young_modulus, cu.poisson_ratio,
-                                       2.0, 0.02 * cu.fracture_energy_ppf(ONSET_QUANTILE, 5.5e-3))
+                                       2.0, 0.02 * brk.bodies[ids[0]].fracture_energy)
     coupling.run_steps(20)
     assert brk.period == min(int(0.25 * placement.hertz_loading_time(
         2.75e-3, cu.density, cu.young_modulus, cu.poisson_ratio, 2.0) / O.dt),
         int(onset / O.dt))
     assert brk.period >= 5                    # it does read less often than every step
+
+
+@pytest.mark.yade
+def test_fast_follows_the_weakest_present_fracture_energy(scene):
+    """A sub-critical impact weakens the particle (Eqs. 5-6): "fast" then bounds a fresh
+    contact's work by 2 % of the lowered fracture energy, not of the one drawn at attach."""
+    from yadebreak import scenes
+    cu = load_material("copper_ore")
+    brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [30.0], seed=3, read_period="fast")
+    drawn = brk.bodies[ids[0]].fracture_energy
+    scenes.run_until_rebound(ids)
+    weakened = brk.bodies[ids[0]].fracture_energy
+    assert [e["kind"] for e in brk.events] == ["damage"] and weakened < 0.98 * drawn
+
+    def onset(energy):
+        return float(placement.hertz_onset_time(2.75e-3, cu.density, cu.young_modulus,
+                                                cu.poisson_ratio, 1.0, 0.02 * energy))
+    assert brk.reach.get(brk.state.tracked)[0] == pytest.approx(onset(weakened), rel=1e-12)
+    assert onset(weakened) < 0.99 * onset(drawn)           # ~ E^0.4: the two are told apart
+
+
+def _unbreakable_impact(read_period):
+    """A 5.5 mm copper ore particle made an unbreakable fragment (whose first stressing past its
+    fracture energy, here 300 J/kg, sets the t10' it keeps) fired at 40 m/s on steel: its
+    unbreakable_stressed events and the warnings of the run."""
+    import warnings
+    from yadebreak import coupling, scenes
+    coupling.forget()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [40.0], seed=3,
+                                       read_period=read_period)
+        brk.bodies[ids[0]].kind = "unbreakable"
+        brk.bodies[ids[0]].fracture_energy = 300.0
+        scenes.run_until_rebound(ids)
+    stressed = [e for e in brk.events if e["kind"] == "unbreakable_stressed"]
+    return stressed, [str(w.message) for w in caught if "rose by" in str(w.message)]
+
+
+@pytest.mark.yade
+def test_fast_reads_unbreakable_fragments_in_time(scene):
+    """"fast" bounds the rise between reads of every tracked body, unbreakable fragments too:
+    no warning, and the fragment's Ek'/m and t10' those of every-step reading (within
+    fast_tolerance, 2 %, of its fracture energy; the t10' within 0.05 points). A schedule that
+    follows the breakable bodies only has none left here and reads every 200 steps: it misses the
+    impact (about 20 steps of loading)."""
+    every, warned_every = _unbreakable_impact("every_step")
+    fast, warned_fast = _unbreakable_impact("fast")
+    assert warned_every == warned_fast == []
+    assert len(every) == len(fast) == 1
+    assert fast[0]["specific_energy"] == pytest.approx(every[0]["specific_energy"], abs=0.02 * 300)
+    assert fast[0]["t10"] == pytest.approx(every[0]["t10"], abs=0.05)
+
+
+@pytest.mark.yade
+def test_a_coarse_fixed_period_warns_and_says_how_wrong_t10_is(scene):
+    """Read every 12 steps, the same impact is read at 1.70 times the fracture energy: the
+    warning gives the rise and the t10' it took against the t10' at the crossing (Eq. 8 at
+    Ek'/(m E) = 1), which every-step reading nearly gives."""
+    import re
+    from yadebreak import model
+    stressed, warned = _unbreakable_impact(12)
+    assert len(stressed) == 1 and len(warned) == 1
+    event, text = stressed[0], warned[0]
+    assert int(re.search(r"rose by (\d+) %", text).group(1)) > 80
+    taken, at_crossing = (float(x) for x in re.search(
+        r"its t10' is ([\d.]+) % .* gives ([\d.]+) %", text).groups())
+    assert taken == pytest.approx(event["t10"], abs=0.005)
+    cu = load_material("copper_ore")
+    assert at_crossing == pytest.approx(float(model.t10(1.0, cu.A, cu.b_prime, cu.kappa)),
+                                        abs=0.005)
+    every, _ = _unbreakable_impact("every_step")
+    assert taken - every[0]["t10"] > 1.0       # a point and more of t10' wrong
+    assert abs(at_crossing - every[0]["t10"]) < 0.2
 
 
 def test_hertz_onset_time_against_an_integrated_hertz_impact():

@@ -78,10 +78,11 @@ OPTIONS = (
     Option("read_fraction", "reading", 0.05, _number(0, 1, lo_open=True), "(0, 1]", "-",
            "'auto': read at this fraction of the Rayleigh time of the smallest breakable body"),
     Option("fast_fraction", "reading", 0.25, _number(0, 1, lo_open=True), "(0, 1]", "-",
-           "'fast': at least 1/this reads per Hertz loading time of the smallest breakable body"),
+           "'fast': at least 1/this reads per Hertz loading time of the smallest tracked body "
+           "(breakable, or an unbreakable fragment not yet stressed)"),
     Option("fast_tolerance", "reading", 0.02, _number(0, 1, lo_open=True), "(0, 1]", "-",
            "'fast': largest rise of a body's energy between reads, as a fraction of its "
-           "fracture energy"),
+           "fracture energy (a fresh contact's, at twice the top speed, included)"),
     # criteria: overrides of the material files and Rocky's safeguards
     Option("kappa", "criteria", None, _number(0, lo_open=True, none=True), "> 0 or None", "-",
            "overrides the material's kappa (Eq. 8); None keeps the file's"),

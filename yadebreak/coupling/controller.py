@@ -12,14 +12,15 @@ import warnings
 
 import numpy as np
 
-from yadebreak.model import families, reports
+from yadebreak.model import families, placement, reports
 from yadebreak.coupling.yade_api import O, utils
 from yadebreak.coupling.contacts import ContactReader
-from yadebreak.coupling.criteria import criterion_for
+from yadebreak.coupling.criteria import AbT10, criterion_for
 from yadebreak.coupling.judging import Judge
 from yadebreak.coupling.replacement import Replacer
 from yadebreak.coupling.state import BREAKABLE, BROKEN, UNBREAKABLE, BodyRow, EngineState
-from yadebreak.coupling.stepping import FragmentDamping, ReadSchedule, SmallestBreakable, TimeStep
+from yadebreak.coupling.stepping import (FragmentDamping, Reach, ReadSchedule, SmallestBreakable,
+                                          TimeStep)
 from yadebreak.coupling.zeroing import OverlapZeroing
 
 
@@ -76,8 +77,11 @@ class Controller:
         self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero",
                                       config.replacement.zeroing_tolerance)
         self.smallest = SmallestBreakable()
+        # "fast": the reach of a fresh contact over every tracked body
+        self.reach = Reach(config.reading.fast_tolerance) if config.reading.read_period == "fast" \
+            else None
         self.schedule = ReadSchedule(config.reading, label, self._smallest_breakable,
-                                     self._low_fracture_energy)
+                                     self._reach if self.reach is not None else None)
         self.time_step = TimeStep(config.time_step.time_step_fraction, self._warn_once)
         gd = config.time_step.global_damping        # None: each material file's
         self.damping = FragmentDamping(
@@ -96,8 +100,11 @@ class Controller:
                            any(self.pause_steps.values()), config.reading.fast_tolerance,
                            self._record, self._warn_jump,
                            config.criteria.break_at == "peak")
+        self.judge.weakened = self._weakened
         self.last_iter = -1
         self.wall_time = {"read": 0.0, "replace": 0.0}
+        if self.reach is not None:            # a restored state: its tracked bodies
+            self._reach_rebuild()
 
     # -- what users read ---------------------------------------------------------------------
     @property
@@ -191,6 +198,8 @@ class Controller:
             k = kind[i]
             if k == BREAKABLE or k == UNBREAKABLE:
                 self.state.tracked.add(i)
+                if self.reach is not None:
+                    self._reach_add(i)
             if k == BREAKABLE:
                 self.smallest.push(float(radius[i]), i)
             O.bodies[i].breakage = BodyRow(table, i)
@@ -198,11 +207,39 @@ class Controller:
     def _smallest_breakable(self):
         return self.smallest.get(self._still_breakable)
 
-    def _low_fracture_energy(self, i, u):
-        """The fracture energy (J/kg) of quantile u of body i's material at its size."""
-        table = self.state.table
-        return float(self.material[table.label_of(i)].fracture_energy_ppf(
-            u, 2.0 * float(table.columns["radius"][i])))
+    def _reach(self, rebuild):
+        if rebuild:
+            self._reach_rebuild()
+        return self.reach.get(self.state.tracked)
+
+    def _reach_rebuild(self):
+        """The reach of every tracked body from the body table, material by material."""
+        c = self.state.table.columns
+        ids = np.array(sorted(self.state.tracked), np.int64)
+        onset, loading = np.empty(len(ids)), np.empty(len(ids))
+        materials = c["material"][ids]
+        for m in np.unique(materials).tolist():
+            rows = np.flatnonzero(materials == m)
+            mat = O.bodies[int(ids[rows[0]])].material
+            radius = c["radius"][ids[rows]]
+            onset[rows] = placement.hertz_onset_time(
+                radius, mat.density, mat.young, mat.poisson, 1.0,
+                self.reach.tolerance * c["fracture_energy"][ids[rows]])
+            loading[rows] = placement.hertz_loading_time(radius, mat.density, mat.young,
+                                                         mat.poisson, 1.0)
+        self.reach.rebuild(ids.tolist(), onset.tolist(), loading.tolist())
+
+    def _reach_add(self, i):
+        c = self.state.table.columns
+        self.reach.add(i, float(c["radius"][i]), float(c["fracture_energy"][i]),
+                       O.bodies[i].material)
+
+    def _weakened(self, i):
+        """A damage lowered body i's fracture energy: "fast" reads follow it."""
+        if self.reach is not None and i in self.state.tracked:
+            c = self.state.table.columns
+            self.reach.update(i, float(c["radius"][i]), float(c["fracture_energy"][i]),
+                              O.bodies[i].material)
 
     def _still_breakable(self, i):
         return i in self.state.tracked and self.state.table.columns["kind"][i] == BREAKABLE
@@ -235,10 +272,25 @@ class Controller:
         self.last_iter = O.iter
         self.schedule.after_read(limits)
 
-    def _warn_jump(self, bid, rise, scale):
+    def _warn_jump(self, bid, rise, scale, ek):
+        """A body broke (or an unbreakable fragment was stressed past its fracture energy) after
+        its energy rose by `rise` (J/kg) between two reads, more than LATE_JUMP of its fracture
+        energy `scale`: its t10' is that of the read, where reading at the crossing gives the
+        criterion's t10' at its threshold (Eq. 8 at Ek'/(m E) = 1; Eq. 9.4 at e_cum = its
+        threshold). The message says both."""
+        table = self.state.table
+        crit = self.criteria[table.label_of(bid)]
+        ratio, t10, _ = crit.breakage(table, bid, ek)
+        if isinstance(getattr(crit, "inner", crit), AbT10):
+            low = float(crit.material.t10_of_cumulative_energy(
+                scale, 2.0 * float(table.columns["radius"][bid])))
+        else:
+            low = crit.breakage(table, bid, scale * float(table.columns["mass"][bid]))[1]
         self._warn_once("jump", (
             f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
-            f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s)"),
+            f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s): "
+            f"its t10' is {t10:.2f} % (at {ratio:.2f} times its fracture energy) where a read at "
+            f"the crossing gives {low:.2f} %"),
             remedies=self.schedule.remedies(), purpose="for an accurate t10'")
 
     def _record(self, kind, bid, **fields):

@@ -23,6 +23,9 @@ SMALL = 24
 
 # what a body needs after the criteria spoke
 NOTHING, FORGET, PAUSE, BREAK, OPEN, CLOSE_IF_UNLOADED = range(6)
+#: the warning that a read came late: a body's criterion variable rose by more than this share of
+#: its fracture energy between two reads, so that its t10' follows the read, not the crossing
+LATE_JUMP = 0.8
 #: loading.strongest of a body whose contacts brought no energy above emin: no partner (-1)
 NO_PARTNER = (0.0, None, 0.0, -1)
 
@@ -60,7 +63,8 @@ class Judge:
         self.pausing = pausing                    # some material pauses fresh fragments
         self.fast_tolerance = fast_tolerance
         self.record = record                      # record(kind, id, **fields)
-        self.warn_jump = warn_jump                # warn_jump(id, rise, threshold)
+        self.warn_jump = warn_jump                # warn_jump(id, rise, threshold, Ek')
+        self.weakened = lambda bid: None          # told of each body a damage weakened
         #: up to this many candidates a read is judged body by body (plan_each)
         self.small = min([SMALL, *(c.judged_one_by_one for c in criterion_of)])
 
@@ -182,8 +186,8 @@ class Judge:
                 if i not in loading.grew and self.reader.stored_share(i) <= self.reader.emin:
                     self.close_event(i)
             elif what == BREAK:
-                if plan.jump[k] > 0.8 * plan.threshold[k]:
-                    self.warn_jump(i, plan.jump[k], plan.threshold[k])
+                if plan.jump[k] > LATE_JUMP * plan.threshold[k]:
+                    self.warn_jump(i, plan.jump[k], plan.threshold[k], float(plan.ek[k]))
                 broken.append((i, float(plan.ek[k]), loading.strongest.get(i)))
             elif what == PAUSE:
                 # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
@@ -208,3 +212,5 @@ class Judge:
         c["event_max"][bid] = c["specific_energy"][bid] = 0.0
         self.state.open_events.discard(bid)
         self.reader.restart(bid)
+        if fields is not None:
+            self.weakened(bid)
