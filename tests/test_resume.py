@@ -143,3 +143,47 @@ def test_zeroed_overlaps_go_on_after_a_reload_as_if_never_saved(scene, tmp_path)
     unsaved = states(2000)
     scene.load(str(tmp_path / "scene.yade.gz"))
     assert states(2000) == unsaved
+
+
+def _same_events(a, b, rel=1e-9):
+    """The same events (kind, body, step; those closed at the run's last step in any order),
+    every number within `rel`."""
+    def ordered(events):
+        return sorted(events, key=lambda e: (e["iter"], e["id"], e["kind"]))
+    a, b = ordered(a), ordered(b)
+    assert [(e["kind"], e["id"], e["iter"]) for e in b] == [(e["kind"], e["id"], e["iter"])
+                                                           for e in a]
+    for x, y in zip(a, b):
+        for key, value in x.items():
+            if isinstance(value, float):
+                assert y[key] == pytest.approx(value, rel=rel, abs=1e-300), (key, x, y)
+
+
+def test_a_bed_resumed_from_any_cut_is_the_uninterrupted_run(scene, tmp_path):
+    """Cut before the first breakage, between the two, just after the second (fresh fragments:
+    zeroed overlaps, reads every step) and in the last unloading, each resumed from its last
+    checkpoint: every event and the summary are the uninterrupted run's (numbers to 1e-9: O.load
+    gives YADE's potential contacts back in another order, see docs/bed_impact.md). What a
+    checkpoint must carry besides O.save's scene: the step of the engine's last read (the next
+    read's interval) and where the rolling friction's checks are."""
+    from yadebreak.runs import bed
+    from yadebreak import coupling
+
+    def run(out, **changes):
+        coupling.forget()
+        scene.reset()
+        return bed.run(_bed_args(out, vtk_interval=0.0, **changes), quiet=True)[1]
+
+    whole = run(tmp_path / "whole")
+    drop = ("runtime_s", "wall_time_read_s", "wall_time_replace_s")
+    for d in (whole,):
+        for key in drop:
+            d.pop(key)
+    for k, cut_at in enumerate((2e-4, 6e-4, 1.0e-3, 1.12e-3)):      # s (breakages: 0.42, 0.98)
+        cut = tmp_path / f"cut{k}"
+        assert run(cut, checkpoint_every=0.0, stop_after=cut_at) is None
+        resumed = run(cut, resume=True)
+        for key in drop:
+            resumed.pop(key)
+        assert resumed == whole, cut_at
+        _same_events(_events(tmp_path / "whole"), _events(cut))

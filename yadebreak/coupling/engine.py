@@ -5,6 +5,7 @@ import json
 import os
 from pathlib import Path
 
+from . import rolling
 from .yade_api import O, find_engine, wrapper
 from .config import AttachError, Config
 from .controller import Controller
@@ -115,7 +116,8 @@ def _store(ctl):
     O.tags[_TAG + ctl.label] = json.dumps({
         "label": ctl.label, "options": ctl.config.as_options(),
         "materials": {k: getattr(v, "source", v) for k, v in ctl.material_names.items()},
-        "iter": O.iter, "runs": _runs(ctl.label), "state": ctl.state.to_dict(),
+        "iter": O.iter, "last_read": ctl.last_iter, "runs": _runs(ctl.label),
+        "state": ctl.state.to_dict(),
         "contacts": ctl.reader.to_dict(), "zeroed": ctl.zeroing.to_list(),
         "damped_until": ctl.damping.until, "fast": ctl.schedule.to_list()})
 
@@ -142,7 +144,7 @@ def _restore(label):
     ctl.reader.restore(data["contacts"])
     ctl.zeroing.restore(data["zeroed"])
     ctl.damping.until = [tuple(x) for x in data["damped_until"]]
-    ctl.last_iter = data["iter"] - 1
+    ctl.last_iter = data.get("last_read", data["iter"] - 1)   # the steps since it: the next read's
     for bid in table:
         b = O.bodies[bid] if bid < len(O.bodies) else None
         if b is not None:
@@ -152,10 +154,12 @@ def _restore(label):
 
 
 def save(path):
-    """O.save the scene with the state of every attached engine (kept in O.tags). O.save alone
-    does not store it: after O.load such a scene refuses to go on rather than go on wrongly."""
+    """O.save the scene with the state of every attached engine and rolling friction part (kept
+    in O.tags). O.save alone does not store it: after O.load such a scene refuses to go on rather
+    than go on wrongly."""
     for ctl in _ENGINES.values():
         _store(ctl)
+    rolling.store()
     O.save(str(path))
 
 
@@ -192,6 +196,7 @@ def load_checkpoint(path, label="yadebreak"):
     if not path.exists():
         raise FileNotFoundError(f"--resume: no checkpoint at {path}; run without --resume first")
     O.load(str(path))
+    rolling.forget()                      # this process's parts: rebuilt from the loaded O.tags
     return None if label is None else controller_of(label), json.loads(O.tags[_SCRIPT_TAG])
 
 
