@@ -187,3 +187,33 @@ def test_a_bed_resumed_from_any_cut_is_the_uninterrupted_run(scene, tmp_path):
             resumed.pop(key)
         assert resumed == whole, cut_at
         _same_events(_events(tmp_path / "whole"), _events(cut))
+
+
+def test_a_checkpoint_keeps_the_last_read_and_the_rolling_checks(scene, tmp_path):
+    """Loaded from a checkpoint taken between two reads, the engine knows the step of its last
+    read (the next read's interval, hence its first-touch work and the "fast" period) and the
+    rolling friction part where its checks are (which one passes over every interaction, the
+    counts the next compares with): the state the saved run had, not a fresh one's."""
+    from yadebreak import coupling
+    from yadebreak.coupling import engine, rolling
+    from yadebreak.runs import bed
+    out = tmp_path / "cut"
+    coupling.forget()
+    assert bed.run(_bed_args(out, vtk_interval=0.0, checkpoint_every=0.0, stop_after=6e-4),
+                   quiet=True)[1] is None                  # stopped just after its checkpoint
+    ctl, part = engine.controller_of("yadebreak"), rolling._PARTS["rolling"]
+    saved = (scene.iter, ctl.last_iter, part._checks, list(part._seen))
+    assert saved[1] < saved[0] - 1 and saved[2] > 1          # between reads, after many checks
+    coupling.forget()
+    rolling.forget()
+    scene.reset()
+    ctl, _ = coupling.load_checkpoint(out / "checkpoint.yade.gz")
+    last_read = ctl.last_iter
+    seen = list(rolling._PARTS["rolling"]._seen) if "rolling" in rolling._PARTS else None
+    assert seen is None                       # rebuilt from the checkpoint at its next run
+    coupling.run_steps(1)
+    part = rolling._PARTS["rolling"]
+    checks = part._checks - (1 if saved[0] % part.period == 0 else 0)    # (if it ran now)
+    assert (scene.iter - 1, last_read, checks) == saved[:3]
+    if checks == part._checks:
+        assert part._seen == saved[3]
