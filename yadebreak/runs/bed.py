@@ -139,6 +139,10 @@ class BedImpact(skeleton.Job):
             loop["touched"] = O.time
             loop["bed_kinetic_energy_at_touch"] = before_touch
             scenes.hold_release(info)
+        # saved and loaded back at each chunk's end, where a checkpoint may be taken: a run
+        # resumed from one goes on exactly as this one
+        self.brk = self.frames.brk = coupling.reload()
+        self.ball = O.bodies[info["ball"]]
         self.frames()                             # a frame if one is due (before the checkpoint)
         vz = self.ball.state.vel[2]
         if loop["touched"] is not None and loop["turned"] is None and vz >= 0.0:
