@@ -69,9 +69,9 @@ def _events(out):
 
 def test_a_bed_killed_after_its_checkpoint_resumes_to_the_same_run(scene, tmp_path):
     """Killed after a checkpoint (its events and frames written past it), resumed: the run's
-    summary is the uninterrupted one's, its events are the same events (kind, body, step), their
-    numbers equal to round-off (O.load rebuilds YADE's interaction list in another order, so
-    forces are summed in another order), and no event or frame of the killed run is left."""
+    summary is the uninterrupted one's, its events are the same events (kind, body, step; those
+    closed at the last step in any order) with the same numbers, and no event or frame of the
+    killed run is left."""
     from yadebreak.runs import bed
     from yadebreak import coupling
 
