@@ -164,7 +164,6 @@ def save(path):
     O.save(str(path))
 
 
-
 def reload(label="yadebreak"):
     """O.save the scene in memory and O.load it back, with the state of every engine and
     rolling friction part; returns engine `label`'s controller, restored (the objects of the
@@ -188,6 +187,7 @@ def reload(label="yadebreak"):
     for name, wall_time in walls.items():
         controller_of(name).wall_time = wall_time          # (this process's measure)
     return controller_of(label) if label is not None else None
+
 
 def save_checkpoint(path, script_state):
     """save() the scene to `path` with a script's loop state (a JSON-able dict), whole or not at

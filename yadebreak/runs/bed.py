@@ -17,7 +17,7 @@ from yadebreak.tools.options import read_period_value
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
 TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
-SAFE_EVERY = 5                   # chunks of steps between two points where a checkpoint may be taken
+SAFE_EVERY = 5                   # chunks of steps between the points where a checkpoint may be
 
 
 def _fates(brk, particles):
