@@ -111,9 +111,9 @@ def test_a_bed_run_that_fails_midway_leaves_its_outputs_and_says_why(scene, tmp_
     from yadebreak import coupling
     real, calls = coupling.run_steps, []
 
-    def failing(n):                     # the fourth batch of steps fails, mid-impact
+    def failing(n):                     # a batch of steps fails after the first checkpoint
         calls.append(n)
-        if len(calls) == 4:
+        if len(calls) == bed.SAFE_EVERY + 1:
             raise RuntimeError("the solver gave up")
         real(n)
     monkeypatch.setattr(coupling, "run_steps", failing)

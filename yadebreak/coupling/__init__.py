@@ -16,8 +16,8 @@ from importlib import import_module
 from yadebreak.coupling.config import AttachError, Config, options_markdown
 
 _NEED_YADE = {"attach": "engine", "controller_of": "engine", "detach": "engine", "forget": "engine",
-              "load_checkpoint": "engine", "run_steps": "engine", "save": "engine",
-              "save_checkpoint": "engine", "Controller": "controller",
+              "load_checkpoint": "engine", "reload": "engine", "run_steps": "engine",
+              "save": "engine", "save_checkpoint": "engine", "Controller": "controller",
               "add_materials": "scene_materials"}
 
 __all__ = ["AttachError", "Config", "options_markdown", *_NEED_YADE]

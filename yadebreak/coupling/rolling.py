@@ -85,11 +85,18 @@ class RollingFriction:
             self.configured += 1
 
     def to_dict(self):
-        return {"mu": [[a, b, v] for (a, b), v in self.mu.items()], "period": self.period}
+        """The settings and where the checks are (which check passes over every interaction,
+        the counts the next check compares with): a loaded scene configures the contacts at the
+        same steps as the saved one would have."""
+        return {"mu": [[a, b, v] for (a, b), v in self.mu.items()], "period": self.period,
+                "checks": self._checks, "seen": list(self._seen)}
 
     @classmethod
     def from_dict(cls, data):
-        return cls({(a, b): v for a, b, v in data["mu"]}, data["period"])
+        part = cls({(a, b): v for a, b, v in data["mu"]}, data["period"])
+        part._checks = data.get("checks", 0)
+        part._seen = list(data.get("seen", ()))
+        return part
 
 
 def rolling_engine(mu, period=DEFAULT_PERIOD, label="rolling"):
@@ -123,6 +130,13 @@ def share_pairs(parent, alias):
                 for pair in ((alias, other),) + (((alias, alias),) if other == parent else ()):
                     part.mu[(min(pair), max(pair))] = mu
         O.tags[_TAG + label] = json.dumps(part.to_dict())
+
+
+def store():
+    """Each part of this scene into O.tags with where its checks are (before O.save)."""
+    for label, part in _PARTS.items():
+        if _TAG + label in O.tags.keys():
+            O.tags[_TAG + label] = json.dumps(part.to_dict())
 
 
 def forget():
