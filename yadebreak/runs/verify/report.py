@@ -50,7 +50,8 @@ def write_report(out, figures, runner, args, wall):
         lines += [f"- {c['what']}: {c['detail']} ({'met' if c['ok'] else '**not met**'})"
                   for c in f["checks"] if "detail" in c]
         lines.append("")
-    (out / "report.md").write_text("\n".join(lines))
-    (out / "results.json").write_text(json.dumps(
+    from yadebreak.tools.lifecycle import write_atomic
+    write_atomic(out / "report.md", "\n".join(lines))
+    write_atomic(out / "results.json", json.dumps(
         {"argv": args.argv, "wall_s": wall, "figures": figures,
          "runs": list(runner.results.values())}, indent=1, default=float))
