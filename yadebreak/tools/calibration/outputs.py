@@ -72,7 +72,8 @@ def fit_json(cal, extra=None):
 
 
 def write_json(cal, path, extra=None):
-    Path(path).write_text(json.dumps(fit_json(cal, extra), indent=2, default=_plain))
+    from yadebreak.tools.lifecycle import write_atomic
+    write_atomic(path, json.dumps(fit_json(cal, extra), indent=2, default=_plain))
 
 
 def _plain(v):
