@@ -282,7 +282,7 @@ def test_fitted_material_breaks_in_yade_as_its_data(tmp_path):
     run = subprocess.run(["nice", "-n", "5", "yade", "-n", "-x", "scripts/single_impact.py",
                           "--material", str(tmp_path / "fit" / "fitted_cu.toml"),
                           "--size", "5.5mm", "--energies", ",".join(f"{e:g}" for e in energies),
-                          "--particles", str(n_sim), "--scene-particles", "20",
+                          "--particles", str(n_sim), "--scene-particles", "20", "--jobs", "1",
                           "--replace", "0",      # breakage is judged alike; no fragments needed
                           "--out", str(out)], cwd=REPO, capture_output=True, text=True,
                          timeout=900)

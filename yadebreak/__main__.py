@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak.model import families
-from yadebreak.tools.lifecycle import kept_outputs, write_atomic
+from yadebreak.tools.lifecycle import write_atomic
 from yadebreak import model
 from yadebreak.model.materials import MaterialError, available_materials, load_material
 from yadebreak.tools.options import (DEBUG, ScriptParser, add_params, fail, integer,
@@ -268,10 +268,22 @@ def environment_error(exc, out, began):
             errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT):
         return
     where = f" {exc.filename}" if exc.filename else ""
-    kept = kept_outputs(out, began) if out else "nothing was written"
-    print(f"[yadebreak] error: cannot write{where}: {exc.strerror or exc}; {kept}",
+    print(f"[yadebreak] error: cannot write{where}: {exc.strerror or exc}; {_kept(out, began)}",
           file=sys.stderr, flush=True)
     raise SystemExit(1) from None
+
+
+def _kept(out, since):
+    """The files of `out` written since `since` (time.time()), each whole, in a few words."""
+    folder = Path(out) if out else None
+    if folder is None or not folder.is_dir():
+        return f"nothing was written in {out}" if out else "nothing was written"
+    new = sorted(str(p.relative_to(folder)) for p in folder.rglob("*")
+                 if p.is_file() and p.stat().st_mtime >= since - 1.0)
+    if not new:
+        return f"nothing was written in {folder}"
+    shown = ", ".join(new[:6]) + (f" and {len(new) - 6} more" if len(new) > 6 else "")
+    return f"kept in {folder}: {shown}"
 
 
 def _value_of(argv, option, default):
