@@ -106,6 +106,7 @@ def check_impact_speed(option, value, speed, material, unit):
     if limit is None or speed < limit:
         return
     bound = {"m/s": limit, "J/kg": 0.5 * limit ** 2, "J": 0.5 * BALL_MASS * limit ** 2}[unit]
+    value = f"{value:g}" if isinstance(value, float) else value
     fail(f"{option} = {value}: must be < {bound:.4g} ({unit}): it means {speed:.4g} m/s, not below "
          f"the elastic wave speed sqrt(E/rho) of {name}, {limit:.4g} m/s, where Hertz contact "
          "means nothing")
