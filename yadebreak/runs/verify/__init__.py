@@ -125,7 +125,7 @@ def verify(args):
         try:
             load_material(name)
         except MaterialError as exc:
-            if args.debug:
+            if getattr(args, "debug", False):
                 raise
             fail(f"--materials = {args.materials}: " + "; ".join(exc.problems))
     out.mkdir(parents=True, exist_ok=True)
