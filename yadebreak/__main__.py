@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -268,7 +269,8 @@ def environment_error(exc, out, began):
             errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT):
         return
     where = f" {exc.filename}" if exc.filename else ""
-    print(f"[yadebreak] error: cannot write{where}: {exc.strerror or exc}; {_kept(out, began)}",
+    verb = "access" if exc.errno in (errno.EACCES, errno.EPERM) else "write"   # may be a read
+    print(f"[yadebreak] error: cannot {verb}{where}: {exc.strerror or exc}; {_kept(out, began)}",
           file=sys.stderr, flush=True)
     raise SystemExit(1) from None
 
@@ -297,7 +299,6 @@ def _value_of(argv, option, default):
 
 
 def main(argv=None):
-    import time
     argv = sys.argv[1:] if argv is None else list(argv)
     began = time.time()
     if argv[:1] in (["tradeoff"], ["verify"], ["fit"]):     # each has its own parser
