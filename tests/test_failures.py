@@ -548,7 +548,7 @@ def test_a_failed_impact_worker_stops_the_run_with_its_last_words(tmp_path):
     shutil.rmtree(kept)
 
 
-# -- python3 -m yadebreak verify and tradeoff: bad input in one line, before --out is made ----------
+# -- python3 -m yadebreak verify and the folder commands: bad input and a read-only --out ------
 @pytest.mark.parametrize("arguments, line", [
     (["--figures", ""], "--figures = '': must be a non-empty text"),
     (["--figures", " , "], "--figures = ' , ': names no figure; accepted probability, targets, "

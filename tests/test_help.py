@@ -1,6 +1,7 @@
 """--help of every `python3 -m yadebreak` command and every script in scripts/: exit code 0 and the
 options listed. In-process (the scripts' options through job_options, as the scripts read them),
-but for two subprocesses: the tradeoff command as users run it and gather_sweep.py (plain Python)."""
+but for three subprocesses: the module's and tradeoff's help as users run them, and
+gather_sweep.py (plain Python)."""
 import subprocess
 from pathlib import Path
 

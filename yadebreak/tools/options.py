@@ -427,7 +427,7 @@ def script_params(params, description=None, argv=None, table_row=None):
         defaults = {p.name: p.default for p in params}
         try:
             row, description = table_row(defaults)
-        except NameError as exc:          # YADE's readParamsFromTable: a column it has no default of
+        except NameError as exc:  # readParamsFromTable: a column without a default
             column = re.search(r"`(\w+)'", str(exc))
             fail(f"the table's column {column.group(1) if column else str(exc)!r} is not an option "
                  f"of this script (its options: {', '.join(sorted(defaults))})")
