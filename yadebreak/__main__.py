@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak.model import families
-from yadebreak.tools.lifecycle import write_atomic
+from yadebreak.tools.lifecycle import save_figure, write_atomic
 from yadebreak import model
 from yadebreak.model.materials import MaterialError, available_materials, load_material
 from yadebreak.tools.options import (DEBUG, ScriptParser, add_params, fail, integer,
@@ -56,7 +56,7 @@ def demo(args):
     axes[2].legend()
     fig.tight_layout()
     path = out / f"model_{mat.name}.png"
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     e50 = float(mat.median_fracture_energy(5.5e-3))
     summary = {"material": mat.name, "E50_5.5mm_J_per_kg": e50,
                "energy_partition_on_steel": mat.energy_partition(steel),
@@ -87,7 +87,7 @@ def plot_families(args):
     ax.legend(fontsize=7)
     fig.tight_layout()
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(args.out, dpi=110)
+    save_figure(fig, args.out, dpi=110)
     print(f"{len(fs.probabilities)} families, volumes {fs.volumes.min():.4f}-{fs.volumes.max():.4f} "
           f"of the parent; t_n of the mixture "
           f"{np.round(fs.mixture_markers(), 2).tolist()} vs Eq. 10 "

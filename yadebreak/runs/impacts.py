@@ -21,8 +21,8 @@ from yadebreak.coupling.yade_api import O
 from yadebreak.model import reports
 from yadebreak.model.materials import load_material
 from yadebreak.runs import skeleton
-from yadebreak.tools.lifecycle import (ScriptError, progress, resume_arguments, time_left,
-                                       write_atomic)
+from yadebreak.tools.lifecycle import (ScriptError, progress, resume_arguments, save_figure,
+                                       time_left, write_atomic)
 from yadebreak.tools.options import read_period_value
 
 
@@ -251,6 +251,6 @@ def _repeated_outputs(args, mat, share, fractions, brk, out, runtime_s, end_reas
            title=f"{mat.name}, {1e3 * args.size:g} mm at {args.energy:g} J/kg on {args.target}")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(out / "repeated_impact.png", dpi=110)
+    save_figure(fig, out / "repeated_impact.png", dpi=110)
     plt.close(fig)
     return summary

@@ -30,7 +30,7 @@ import numpy as np
 from scipy import stats
 
 from yadebreak.tools import sweep
-from yadebreak.tools.lifecycle import write_atomic
+from yadebreak.tools.lifecycle import save_figure, write_atomic
 
 #: confidence level of the intervals
 LEVEL = 0.95
@@ -320,7 +320,7 @@ def plot_pareto(rows, metrics, path, title):
              family="monospace")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout(rect=(0, 0, 1 - key_width, 0.95))
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 

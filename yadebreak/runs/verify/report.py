@@ -19,7 +19,8 @@ def save(fig, path, settings):
     lines = wrapped.count("\n") + 1
     fig.tight_layout(rect=(0, 0.035 * lines + 0.02, 1, 1))
     fig.text(0.01, 0.01, wrapped, fontsize=7, va="bottom")
-    fig.savefig(path, dpi=110)
+    from yadebreak.tools.lifecycle import save_figure
+    save_figure(fig, path, dpi=110)
     plt_module().close(fig)
     return path
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from yadebreak.model.intervals import PARTICLE_SIZE
 from yadebreak.model.materials import load_material
-from yadebreak.tools.lifecycle import progress, write_atomic
+from yadebreak.tools.lifecycle import progress, save_figure, write_atomic
 from yadebreak.tools.options import UNITS, ParamError, number, number_and_unit
 from .classes import (FeedError, class_label, feed_masses, feed_top_sieve, read_psd_csv,
                       root2_classes)
@@ -190,7 +190,7 @@ def _plot(out, material, classes, result, s0):
     axes[2].set(xlabel="minutes", ylabel="breakage rate (1/min)", title="breakage rate per class")
     axes[2].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(out / "grind.png", dpi=110)
+    save_figure(fig, out / "grind.png", dpi=110)
     plt.close(fig)
 
 
