@@ -7,19 +7,19 @@ Writes configurations.csv, configurations.md and the figures (yadebreak.tools.be
 docs/outputs.md). The sweep's own sweep.csv, a row per table line, is written by `python3 -m
 yadebreak sweep` or `python3 -m yadebreak gather`.
 """
-import argparse
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from yadebreak.tools.bed_report import report  # noqa: E402
+from yadebreak.tools.options import ScriptParser, out_option, read_params  # noqa: E402
 
-parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+parser = ScriptParser(description=__doc__)
 parser.add_argument("--sweep", default="out/sweep",
                     help="folder of the yade-batch runs; default out/sweep")
 parser.add_argument("--out", default="out/sweep_report",
                     help="output folder; default out/sweep_report")
 parser.add_argument("--table", default="",
                     help="the sweep's yade-batch table, to list its lines not run yet; default none")
-args = parser.parse_args()
+args = read_params(parser.parse_args(), [out_option("out/sweep_report")])
 print(report(args.sweep, args.out, args.table))

@@ -24,6 +24,7 @@ from yadebreak import model
 from yadebreak.tools.calibration import (ab_t10, bootstrap, damage, data, examples, fit_all, fracture,
                                    progeny, t10)
 from yadebreak.model.materials import load_material
+from yadebreak.tools.calibration.mle import FitError
 
 REPO = Path(__file__).resolve().parent.parent
 TAVARES = ("copper_ore", "granulite", "limestone_2", "iron_ore_1")
@@ -216,6 +217,10 @@ def write(tmp_path, name, text):
      "more tested"),
     ("size_mm,energy_J_per_kg,impact,tested,broken\n5,100,1,50,10\n5,100,3,40,3\n", 3, "impact",
      "numbered"),
+    # v = sqrt(2e) beyond the fastest wave speed of any accepted material (7.5e9 J/kg)
+    ("size_mm,energy_J_per_kg\n5,100\n5,1e300\n", 3, "energy_J_per_kg",
+     "must be in (0, 7.5e+09) (J/kg)"),
+    ("size_mm,energy_J_per_kg\n5,100\n5000,200\n", 3, "size_mm", "must be in [0.001, 1000] (mm)"),
 ])
 def test_bad_data_names_file_line_and_column(tmp_path, text, line, column, words):
     path = write(tmp_path, "lab.csv", text)
@@ -243,6 +248,65 @@ def test_cli_bad_data_exit_2_one_line_no_material(tmp_path):
     res = run_fit(few, "--out", tmp_path / "out")      # one class, no base: d0, phi unfittable
     assert res.returncode == 2 and "d0, phi" in res.stderr
     assert not list((tmp_path / "out").glob("*.toml"))
+
+
+def _fit_here(capsys, *args):
+    """`python3 -m yadebreak fit` in this process: its exit code and its stderr's lines."""
+    from yadebreak.__main__ import main
+    with pytest.raises(SystemExit) as end:
+        main(["fit", *map(str, args)])
+    return end.value.code, capsys.readouterr().err.strip().splitlines()
+
+
+def test_cli_refuses_what_the_data_cannot_determine(tmp_path, capsys):
+    """One particle cannot give e_inf, sigma and emax_ratio (d0 and phi from --base): at least
+    one broken particle more than the free parameters; energies beyond the --base material's own
+    wave speed (copper ore: 4213 m/s, 8.874e6 J/kg) are refused too."""
+    one = write(tmp_path, "one.csv", "size_mm,energy_J_per_kg\n5.5,100\n")
+    code, err = _fit_here(capsys, one, "--out", tmp_path / "out", "--base", "copper_ore")
+    assert code == 2 and err == ["[yadebreak] error: parameters e_inf, sigma, emax_ratio: 1 "
+                                 f"particles that broke in {one}, at least 4 are needed to "
+                                 "determine them"]
+    fast = write(tmp_path, "fast.csv", "size_mm,energy_J_per_kg\n5.5,100\n5.5,9e6\n")
+    code, err = _fit_here(capsys, fast, "--out", tmp_path / "out", "--base", "copper_ore")
+    assert code == 2 and len(err) == 1 and "line 3" in err[0]
+    assert "must be in (0, 8.87372e+06) (J/kg)" in err[0] and "4213 m/s" in err[0]
+    code, err = _fit_here(capsys, one, "--out", "")
+    assert code == 2 and err == ["[yadebreak] error: --out = '': must be a non-empty text"]
+    assert not (tmp_path / "out").exists()
+
+
+def test_t10_and_gamma_need_more_than_one_level():
+    """A and b' from one energy level (here repeated thrice), gamma from first impacts only: the
+    relation is not determined and the fit says which data are missing."""
+    mat = load_material("copper_ore")
+    frac = {k: getattr(mat, k) * (1e3 if k == "d0" else 1.0)
+            for k in ("e_inf", "d0", "phi", "sigma", "emax_ratio")}
+    one_level = table_of("t10", [[10.0, 500.0, 20.0], [10.0, 500.0, 22.0], [10.0, 500.0, 21.0]])
+    with pytest.raises(FitError, match="A, b_prime: 1 energy levels"):
+        t10.fit_t10(one_level, frac, device_of(mat))
+    first_only = table_of("repeated", [[16.0, 300.0, 1, 50, 10], [16.0, 400.0, 1, 50, 20]])
+    with pytest.raises(FitError, match="gamma: 0 rows of impacts after the first"):
+        damage.fit_gamma(first_only, frac, device_of(mat))
+
+
+def test_a_full_disk_leaves_no_torn_file(tmp_path, capsys, monkeypatch):
+    """The disk fills at the first file written: one line, exit code 1, no material file and no
+    temporary file left (each file is written whole: write_atomic)."""
+    import errno
+    import os
+
+    def full(src, dst):
+        raise OSError(errno.ENOSPC, "No space left on device")
+    monkeypatch.setattr(os, "replace", full)
+    ex = REPO / "docs" / "examples" / "calibration"
+    out = tmp_path / "out"
+    code, err = _fit_here(capsys, ex / "fracture_energies.csv", "--out", out, "--base",
+                          "copper_ore")
+    assert code == 1 and len(err) == 1, err
+    assert err[0].startswith("[yadebreak] error: cannot write: No space left on device; ")
+    assert list(out.iterdir()) == []             # the material file came first: nothing kept
+    assert err[0].endswith(f"nothing was written in {out}")
 
 
 def test_cli_writes_a_loadable_material_with_intervals(tmp_path):
@@ -282,7 +346,7 @@ def test_fitted_material_breaks_in_yade_as_its_data(tmp_path):
     run = subprocess.run(["nice", "-n", "5", "yade", "-n", "-x", "scripts/single_impact.py",
                           "--material", str(tmp_path / "fit" / "fitted_cu.toml"),
                           "--size", "5.5mm", "--energies", ",".join(f"{e:g}" for e in energies),
-                          "--particles", str(n_sim), "--scene-particles", "20",
+                          "--particles", str(n_sim), "--scene-particles", "20", "--jobs", "1",
                           "--replace", "0",      # breakage is judged alike; no fragments needed
                           "--out", str(out)], cwd=REPO, capture_output=True, text=True,
                          timeout=900)

@@ -583,3 +583,42 @@ def test_a_failed_impact_worker_stops_the_run_with_its_last_words(tmp_path):
     kept = Path(re.search(r"are in (\S+) \(", str(failed.value)).group(1))   # the pool's queue
     assert (kept / "0.err").exists()
     shutil.rmtree(kept)
+
+
+# -- python3 -m yadebreak verify and the folder commands: bad input and a read-only --out ------
+@pytest.mark.parametrize("arguments, line", [
+    (["--figures", ""], "--figures = '': must be a non-empty text"),
+    (["--figures", " , "], "--figures = ' , ': names no figure; accepted probability, targets, "
+     "sizes, repeated, progeny, drop_weight, t10, time_step, cs, damping"),
+    (["--materials", "nosuch"], "--materials = nosuch: unknown material 'nosuch'"),
+    (["--out", ""], "--out = '': must be a non-empty text"),
+])
+def test_verify_refuses_bad_input_in_one_line(tmp_path, capsys, arguments, line):
+    from yadebreak.__main__ import main
+    out = tmp_path / "v"
+    with pytest.raises(SystemExit) as end:
+        main(["verify", "--out", str(out), *arguments])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert end.value.code == 2 and len(err) == 1 and err[0].startswith(f"[yadebreak] error: "
+                                                                       f"{line}"), err
+    assert not out.exists()
+
+
+def test_a_read_only_out_ends_a_command_in_one_line(tmp_path, capsys, monkeypatch):
+    """mkdir of --out refused (a read-only file system; chmod does not stop root): one line, exit
+    code 1, for the commands that write a folder."""
+    import errno
+    from yadebreak.__main__ import main
+
+    def read_only(self, *args, **kwargs):
+        raise OSError(errno.EROFS, "Read-only file system", str(self))
+    monkeypatch.setattr(Path, "mkdir", read_only)
+    out = tmp_path / "ro"
+    for command in (["demo"], ["grind", "synthetic:30"], ["verify", "--quick", "1"],
+                    ["fit", str(ROOT / "docs" / "examples" / "calibration" / "t10.csv"), "--base",
+                     "copper_ore"]):
+        with pytest.raises(SystemExit) as end:
+            main([*command, "--out", str(out)])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert end.value.code == 1 and err == [f"[yadebreak] error: cannot write {out}: Read-only "
+                                               f"file system; nothing was written in {out}"], err

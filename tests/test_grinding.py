@@ -17,6 +17,7 @@ from yadebreak.tools.grinding import (BatchGrinder, GrindingError, SpectraError,
                                 synthetic_spectra, write_spectra)
 from yadebreak.tools.grinding.capture import PACKING_MONOLAYER
 from yadebreak.tools.grinding.classes import FeedError
+from yadebreak.tools.grinding.cli import parse_feed
 from yadebreak.model.materials import load_material
 from yadebreak import model
 
@@ -405,3 +406,47 @@ def test_grind_command_writes_the_product_over_time(tmp_path):
     last = [float(r["passing_percent"]) for r in rows if float(r["minutes"]) == 1.0]
     assert last[0] == pytest.approx(100.0) and np.all(np.diff(last) <= 1e-9) and last[1] < 100
     assert summary["specific_energy_kWh_per_t"] > 0 and (out / "grind.png").is_file()
+
+
+# --------------------------------------------------------------------------- units and the disk
+@pytest.mark.parametrize("text_value", ["8", "8mm", "8 mm", "0.8cm", "0.008 m", "8e-3m"])
+def test_feed_size_plain_in_mm_or_with_a_length_unit(text_value):
+    assert parse_feed(text_value) == pytest.approx(8e-3, rel=1e-15)
+
+
+def test_feed_outside_the_particle_sizes_or_not_a_size_is_refused(tmp_path):
+    with pytest.raises(FeedError, match=r"--feed = 2 m: must be in \[0.001, 1000\] \(mm\)"):
+        parse_feed("2 m")
+    with pytest.raises(FeedError, match=r"--feed = 0: must be in \[0.001, 1000\] \(mm\)"):
+        parse_feed("0")
+    with pytest.raises(FeedError, match="cannot be read"):         # not a length: a file name
+        parse_feed("8 kg")
+
+
+def test_grind_on_a_full_disk_ends_in_one_line_and_leaves_whole_files(tmp_path, capsys,
+                                                                      monkeypatch):
+    """The disk fills at the third file (psd.csv and breakage_rate.csv written before): exit 1,
+    one line naming the two files kept, each whole, and no temporary file."""
+    import errno
+    import os
+    from yadebreak.__main__ import main
+    real, calls = os.replace, []
+
+    def replace(src, dst):
+        calls.append(dst)
+        if len(calls) > 3:              # spectra.csv, psd.csv, breakage_rate.csv, then full
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(src, dst)
+    monkeypatch.setattr(os, "replace", replace)
+    out = tmp_path / "g"
+    with pytest.raises(SystemExit) as end:
+        main(["grind", "synthetic:30", "--feed", "3mm", "--minutes", "60 s", "--classes", "6",
+              "--cells", "40", "--out", str(out)])
+    assert end.value.code == 1
+    err = [line for line in capsys.readouterr().err.splitlines() if "error" in line]
+    assert err == ["[yadebreak] error: cannot write: No space left on device; kept in "
+                   f"{out}: breakage_rate.csv, psd.csv, spectra.csv"]
+    assert sorted(p.name for p in out.iterdir()) == ["breakage_rate.csv", "psd.csv", "spectra.csv"]
+    with open(out / "psd.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert sorted({float(r["minutes"]) for r in rows}) == [0.0, 0.5, 1.0]     # whole

@@ -143,7 +143,8 @@ def test_a_script_refuses_an_absurd_material_in_one_line_before_running(tmp_path
     path = _write(tmp_path, GOOD.replace("young_modulus = 52 ", "young_modulus = 1e-300 "))
     script = Path(yadebreak.__file__).resolve().parent.parent / "scripts" / "single_impact.py"
     proc = subprocess.run(["yade", "-n", "-x", str(script), "--material", str(path),
-                           "--energies", "100", "--particles", "2", "--out", str(tmp_path / "o")],
+                           "--energies", "100", "--particles", "2", "--jobs", "1",
+                           "--out", str(tmp_path / "o")],
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 2
     errors = [line for line in proc.stderr.splitlines() if "[yadebreak]" in line]

@@ -97,7 +97,7 @@ def test_bed_impact_outputs_are_documented(tmp_path):
 def test_single_impact_outputs_are_documented(tmp_path):
     out = tmp_path / "single"
     summary = _run("single_impact", out, "--material", "ab_t10_ore", "--particles", "3",
-                   "--energies", "400")
+                   "--energies", "400", "--jobs", "1")
     assert summary["results"][0]["broken_fraction"] > 0       # the progeny fields are there
     assert dotted(summary) - documented("`single_impact.py`") == set()
     missing, kinds = _undocumented_event_fields(sorted(out.glob("events_*.jsonl")))

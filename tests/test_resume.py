@@ -21,7 +21,8 @@ def _script(name, out, *extra):
 @pytest.mark.parametrize("name, arguments", [
     ("repeated_impact", ["--material", "ab_t10_ore", "--size", "5.5e-3", "--energy", "180",
                          "--impacts", "4", "--particles", "30"]),
-    ("single_impact", ["--material", "limestone", "--energies", "60,120", "--particles", "30"]),
+    ("single_impact", ["--material", "limestone", "--energies", "60,120", "--particles", "30",
+                       "--jobs", "1"]),
     ("drop_weight", ["--material", "limestone", "--energies", "60,120", "--particles", "6",
                      "--max-time", "3e-4"]),
 ])
@@ -43,7 +44,7 @@ def test_interrupted_script_resumes_to_the_same_result(tmp_path, name, arguments
 
 
 def test_resume_with_other_arguments_is_refused(tmp_path):
-    args = ["--material", "limestone", "--energies", "60,120", "--particles", "20"]
+    args = ["--material", "limestone", "--jobs", "1", "--energies", "60,120", "--particles", "20"]
     _script("single_impact", tmp_path, *args, "--stop-after", "1")
     proc = subprocess.run(["yade", "-n", "-x", str(ROOT / "scripts" / "single_impact.py"),
                            "--out", str(tmp_path), *args[:-1], "30", "--resume", "1"],

@@ -5,6 +5,7 @@ and says when the run had finished. The options are read in this process, as eac
 them (yadebreak.runs.job_options); one script run as users run it shows that the scripts wire
 them through."""
 import json
+import os
 import subprocess
 from pathlib import Path
 
@@ -67,6 +68,14 @@ BAD_VALUES = [
     ("ball_mill", ["--ore-filling", "0"], "--ore-filling = 0", "in (0, 0.5]", "(no unit)"),
     ("ball_mill", ["--duration", "0"], "--duration = 0", "> 0", "(s)"),
     ("ball_mill", ["--ball-size", "0.2"], "--ball-size = 0.2", "< the drum's radius 0.125", "(m)"),
+    ("bed_impact", ["--dmin", "2"], "--dmin = 2", "in [0, 1]", "(m)"),
+    # impacts at or above the particles' elastic wave speed sqrt(E/rho) (copper ore: 4213 m/s;
+    # the bed's ball of 2.78 kg: 0.5 * 2.78 * 4213^2 = 2.467e7 J)
+    ("bed_impact", ["--energy", "1e300"], "--energy = 1e+300", "< 2.467e+07", "(J)"),
+    ("bed_impact", ["--speed", "5000"], "--speed = 5000", "< 4213", "(m/s)"),
+    ("single_impact", ["--energies", "100,1e9"], "--energies = 100,1e9", "< 8.874e+06", "(J/kg)"),
+    ("repeated_impact", ["--energy", "1e7"], "--energy = 1e+07", "< 8.874e+06", "(J/kg)"),
+    ("drop_weight", ["--energies", "2e7"], "--energies = 2e7", "< 8.874e+06", "(J/kg)"),
 ]
 
 
@@ -79,6 +88,52 @@ def test_bad_value_stops_before_the_run_with_one_line(tmp_path, capsys, script, 
     line = _the_error_line(said.out + said.err)
     assert f"{named}: must be {accepted}" in line and unit in line, line
     assert not out.exists()                          # stopped before anything was built
+
+
+@pytest.mark.parametrize("script", sorted(job_options.JOBS))
+def test_an_empty_out_is_refused(capsys, script):
+    """--out '' would write into the current folder."""
+    assert _read(script, "--out", "") == 2
+    said = capsys.readouterr()
+    assert _the_error_line(said.out + said.err) == ("[yadebreak] error: --out = '': must be a "
+                                                    "non-empty text")
+
+
+def test_speeds_below_the_wave_speed_are_accepted():
+    assert _read("bed_impact", "--energy", "2.4e7", "--out", "x") is None     # 4155 m/s
+    assert _read("single_impact", "--energies", "8.8e6", "--out", "x") is None
+
+
+def test_jobs_default_to_the_usable_cores():
+    from yadebreak.runs.verify import PARAMS
+    cores = len(os.sched_getaffinity(0))
+    assert job_options.read("single_impact", None, []).jobs == cores
+    assert [p.default for p in PARAMS if p.name == "jobs"] == [cores]
+    assert job_options.read("single_impact", None, ["--jobs", "1"]).jobs == 1
+
+
+def test_a_tables_unknown_column_is_named_in_one_line(monkeypatch, capsys):
+    """YADE's readParamsFromTable raises NameError for a column without a default."""
+    def table_row(defaults):
+        raise NameError("Parameter `nosuch' has no default value assigned")
+    monkeypatch.setenv("YADE_BATCH", "t.table:2")
+    with pytest.raises(SystemExit) as end:
+        script_params([SIZE], table_row=table_row)
+    assert end.value.code == 2
+    said = capsys.readouterr()
+    assert _the_error_line(said.out + said.err) == (
+        "[yadebreak] error: the table's column 'nosuch' is not an option of this script (its "
+        "options: debug, size)")
+
+
+@pytest.mark.parametrize("text_value, minutes", [("10", 10.0), ("90s", 1.5), ("90 s", 1.5),
+                                                 ("1h", 60.0), ("2 min", 2.0)])
+def test_minutes_take_a_time_unit(text_value, minutes):
+    from yadebreak.__main__ import COMMANDS
+    option = next(p for p in COMMANDS["grind"][2] if p.name == "minutes")
+    assert option.convert(text_value) == minutes
+    with pytest.raises(ParamError, match=r"--minutes = 5 m: .*\(min\); the unit 'm' is not "):
+        option.convert("5 m")
 
 
 @pytest.mark.parametrize("script", sorted(job_options.JOBS))
@@ -117,7 +172,8 @@ ENERGY = number("energy", 3.05, "J", "impact energy", lo=0, lo_open=True)
 ENERGIES = numbers("energies", "100,200,400", "J/kg", "specific energies", lo=0, lo_open=True)
 
 
-@pytest.mark.parametrize("size", ["5.5mm", "5.5e-3", "0.0055", "5.5e-3m", "0.55cm", "5.5 mm"])
+@pytest.mark.parametrize("size", ["5.5mm", "5.5e-3", "0.0055", "5.5e-3m", "0.55cm", "5.5 mm",
+                                  "5.5e-3 m"])
 def test_a_size_means_the_same_with_or_without_its_unit(size):
     assert script_params([SIZE], argv=["--size", size]).size == 5.5e-3
     assert script_params([SIZE], argv=[]).size == 5.5e-3

@@ -8,15 +8,17 @@ from __future__ import annotations
 
 import json
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
 from yadebreak.model import families
+from yadebreak.tools.lifecycle import save_figure, write_atomic
 from yadebreak import model
 from yadebreak.model.materials import MaterialError, available_materials, load_material
-from yadebreak.tools.options import (DEBUG, ScriptParser, add_params, fail, integer, join_negative_values,
-                         number, read_params, text)
+from yadebreak.tools.options import (DEBUG, ScriptParser, add_params, fail, integer,
+                                     join_negative_values, number, out_option, read_params, text)
 
 
 def _plt():
@@ -54,12 +56,12 @@ def demo(args):
     axes[2].legend()
     fig.tight_layout()
     path = out / f"model_{mat.name}.png"
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     e50 = float(mat.median_fracture_energy(5.5e-3))
     summary = {"material": mat.name, "E50_5.5mm_J_per_kg": e50,
                "energy_partition_on_steel": mat.energy_partition(steel),
                "t10_min_percent": mat.t10_min, "plot": str(path)}
-    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    write_atomic(out / "summary.json", json.dumps(summary, indent=2))
     print(f"{mat.name}: E50(5.5 mm) = {e50:.1f} J/kg, e on steel = "
           f"{mat.energy_partition(steel):.3f}, t10' from {mat.t10_min:.2f} % to A = {mat.A:g} %")
     print(f"wrote {path}")
@@ -85,7 +87,7 @@ def plot_families(args):
     ax.legend(fontsize=7)
     fig.tight_layout()
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(args.out, dpi=110)
+    save_figure(fig, args.out, dpi=110)
     print(f"{len(fs.probabilities)} families, volumes {fs.volumes.min():.4f}-{fs.volumes.max():.4f} "
           f"of the parent; t_n of the mixture "
           f"{np.round(fs.mixture_markers(), 2).tolist()} vs Eq. 10 "
@@ -147,7 +149,7 @@ TRADEOFF_USAGE = """python -m yadebreak tradeoff SCRIPT [script options] --vary 
 Runs SCRIPT over the grid of the varied options x seeds 1..N (the same seeds for every variant),
 one Dask task per run (as `sweep`), reads each run's summary.json and writes DIR/tradeoff.csv,
 tradeoff.md and pareto.png: per variant the wall time, the speed-up against the reference (the
---reference variant, or the slowest) and each metric's paired difference from it with a 95 %
+--reference variant, or the slowest) and each metric's paired difference from it with a 95 %%
 interval. NAME is the script's option without its dashes (--vary time-step-fraction=0.02,0.05);
 KEY a dotted summary.json key (results.0.broken_fraction); options of the script not varied
 follow SCRIPT and reach every run."""
@@ -163,7 +165,8 @@ def tradeoff_command(argv):
     parser.add_argument("--vary", action="append", default=[], help="NAME=V1,V2,... (repeatable)")
     parser.add_argument("--seeds", default="5", help="seeds 1..N per variant; default 5")
     parser.add_argument("--metrics", default="", help="dotted summary.json keys, comma-separated")
-    parser.add_argument("--out", default="out/tradeoff", help="output folder")
+    parser.add_argument("--out", default="out/tradeoff", help="output folder; default "
+                        "out/tradeoff")
     parser.add_argument("--reference", default="", help="NAME=V,... (default: the slowest)")
     parser.add_argument("--scheduler", default="local", help="as for sweep; default local")
     parser.add_argument("--retries", default="1", help="as for sweep; default 1")
@@ -174,6 +177,7 @@ def tradeoff_command(argv):
         if not text_value.isdigit() or (name == "seeds" and int(text_value) < 1):
             fail(f"--{name} = {text_value}: must be an integer >= {1 if name == 'seeds' else 0}")
         numbers[name] = int(text_value)
+    read_params(args, [out_option("out/tradeoff")])
     try:
         varied = to.parse_vary(args.vary)
         to.run(args.script, script_args, varied, numbers["seeds"],
@@ -216,17 +220,17 @@ def _grind(args):
 COMMANDS = {
     "demo": (demo, "plot breakage probability and t10 curves of a material", [
         text("material", "copper_ore", "a material name or a .toml file"),
-        text("out", "out/demo", "output folder")]),
+        out_option("out/demo")]),
     "families": (plot_families, "plot the family set of a t10' (paper Fig. 2)", [
         text("material", "table1", "a material name, or table1"),
         number("t10", 3.0, "%", "t10' of the family set", lo=0, lo_open=True, hi=100),
         integer("seed", 0, "seed of the family generation", lo=0),
-        text("out", "out/families.png", "the plot (PNG)")]),
+        out_option("out/families.png", "the plot (PNG)")]),
     "materials": (list_materials, "list the material library", []),
     "options": (print_options, "the engine's options as Markdown (docs/options.md)", []),
     "sweep": (sweep, "run a yade-batch table's lines as Dask tasks, on this machine or a cluster", [
-        text("out", "out/sweep", "folder of the sweep: <out>/<description>/ per line, "
-             "sweep.json, sweep.csv"),
+        out_option("out/sweep", "folder of the sweep: <out>/<description>/ per line, "
+                   "sweep.json, sweep.csv"),
         text("scheduler", "local", "local, local:N (N workers), tcp://HOST:PORT (a running "
              "scheduler), slurm or pbs (dask-jobqueue)"),
         integer("retries", 1, "further attempts of a failing line in this call", lo=0),
@@ -235,12 +239,13 @@ COMMANDS = {
              "queue=short,walltime=02:00:00,memory=4GB,cores=1)")],
         [("table", "the yade-batch table"), ("script", "the YADE script each line runs")]),
     "gather": (gather, "flatten every line's summary.json of a sweep into <out>/sweep.csv", [
-        text("out", "out/sweep", "the folder holding <description>/summary.json per line")],
+        out_option("out/sweep", "the folder holding <description>/summary.json per line")],
         [("table", "the yade-batch table")]),
     "grind": (_grind, "minutes of batch grinding from a mill's collision "
               "spectra (docs/grinding.md)", [
         text("material", "copper_ore", "a material name or a .toml file"),
-        text("feed", "5.5", "a single feed size (mm) or a CSV file size_mm,passing_percent"),
+        text("feed", "5.5", "a single feed size (plain numbers in mm; a length unit may follow: "
+             "8mm, '0.008 m') or a CSV file size_mm,passing_percent", empty=False),
         number("minutes", 10.0, "min", "grinding time", lo=0, lo_open=True, hi=1e4),
         number("interval", 0.5, "min", "time between outputs", lo=0, lo_open=True),
         integer("classes", 16, "root-2 size classes below the feed's top size", lo=2, hi=60),
@@ -249,22 +254,68 @@ COMMANDS = {
         number("holdup", 0.0, "kg", "ore in the mill (0: the spectra's ore mass)", lo=0),
         number("residence", 0.0, "min", "mean residence time of a continuous mill (0: batch)",
                lo=0),
-        text("out", "out/grind", "output folder")],
+        out_option("out/grind")],
         [("spectra", "a spectra file, a mill run's --out folder (converted) or "
           "synthetic:BALL_MM (docs/grinding.md)")]),
 }
 
 
+def environment_error(exc, out, began):
+    """A command's end on a folder it cannot write (read-only, no permission, a full disk or
+    quota): one line naming the path and what was kept of `out`, exit code 1 (every file is
+    written whole or not at all: write_atomic). Returns (the caller re-raises) for other errors."""
+    import errno
+    if not isinstance(exc, OSError) or exc.errno not in (
+            errno.EROFS, errno.EACCES, errno.EPERM, errno.ENOSPC, errno.EDQUOT):
+        return
+    where = f" {exc.filename}" if exc.filename else ""
+    verb = "access" if exc.errno in (errno.EACCES, errno.EPERM) else "write"   # may be a read
+    print(f"[yadebreak] error: cannot {verb}{where}: {exc.strerror or exc}; {_kept(out, began)}",
+          file=sys.stderr, flush=True)
+    raise SystemExit(1) from None
+
+
+def _kept(out, since):
+    """The files of `out` written since `since` (time.time()), each whole, in a few words."""
+    folder = Path(out) if out else None
+    if folder is None or not folder.is_dir():
+        return f"nothing was written in {out}" if out else "nothing was written"
+    new = sorted(str(p.relative_to(folder)) for p in folder.rglob("*")
+                 if p.is_file() and p.stat().st_mtime >= since - 1.0)
+    if not new:
+        return f"nothing was written in {folder}"
+    shown = ", ".join(new[:6]) + (f" and {len(new) - 6} more" if len(new) > 6 else "")
+    return f"kept in {folder}: {shown}"
+
+
+def _value_of(argv, option, default):
+    """`option`'s value in `argv` (`--out DIR` or `--out=DIR`), or `default`."""
+    for k, a in enumerate(argv):
+        if a == option and k + 1 < len(argv):
+            return argv[k + 1]
+        if a.startswith(option + "="):
+            return a.partition("=")[2]
+    return default
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv[:1] == ["tradeoff"]:
-        return tradeoff_command(argv[1:])
-    if argv[:1] == ["verify"]:             # runs YADE in this process: imported only here
-        from yadebreak.runs.verify import main as verify_main
-        return verify_main(argv[1:])
-    if argv[:1] == ["fit"]:                # DATA... takes several files: its own parser
-        from yadebreak.tools.calibration.cli import main as fit_main
-        return fit_main(argv[1:])
+    began = time.time()
+    if argv[:1] in (["tradeoff"], ["verify"], ["fit"]):     # each has its own parser
+        if argv[0] == "tradeoff":
+            run, out = tradeoff_command, "out/tradeoff"
+        elif argv[0] == "verify":          # runs YADE in this process: imported only here
+            from yadebreak.runs.verify import main as run
+            out = "out/verify"
+        else:                              # DATA... takes several files
+            from yadebreak.tools.calibration.cli import main as run
+            out = None
+        try:
+            return run(argv[1:])
+        except OSError as exc:
+            if _value_of(argv, "--debug", "0") not in ("1", "true", "yes", "on"):
+                environment_error(exc, _value_of(argv[1:], "--out", out), began)
+            raise
     parser = ScriptParser(prog="python -m yadebreak")
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("tradeoff", help="speed against accuracy of a script's options, over seeds "
@@ -288,6 +339,10 @@ def main(argv=None):
         if args.debug:
             raise
         fail(f"{exc.source}: " + "; ".join(exc.problems))
+    except OSError as exc:
+        if not args.debug:
+            environment_error(exc, getattr(args, "out", None), began)
+        raise
     return 0
 
 

@@ -55,3 +55,17 @@ YOUNG_MODULUS = Interval(1e5, 1.5e12)
 POISSON_RATIO = Interval(0.0, 0.5, hi_open=True)
 #: m: particle and sphere sizes and the models' size parameters, 1 um to 1 m
 PARTICLE_SIZE = Interval(1e-6, 1.0)
+#: J/kg: specific impact energies v^2/2 below the fastest elastic wave speed sqrt(E/rho) of the
+#: ranges above (7.5e9 J/kg); a known material has its own, lower limit (elastic_wave_speed)
+SPECIFIC_ENERGY = Interval(0.0, 0.5 * YOUNG_MODULUS.hi / DENSITY.lo, lo_open=True, hi_open=True)
+
+
+def elastic_wave_speed(young_modulus, density):
+    """sqrt(E/rho) (m/s): the speed of sound in a rod of the material. An impact at or above it
+    is not a contact that Hertz's quasi-static law describes: the scripts refuse such speeds."""
+    return math.sqrt(young_modulus / density)
+
+
+# -- the bed impact's ball (the paper's steel ball) ------------------------------------------------
+BALL_DIAMETER = 0.088          # m
+BALL_MASS = 2.78               # kg

@@ -21,7 +21,8 @@ from yadebreak.coupling.yade_api import O
 from yadebreak.model import reports
 from yadebreak.model.materials import load_material
 from yadebreak.runs import skeleton
-from yadebreak.tools.lifecycle import ScriptError, progress, resume_arguments, time_left
+from yadebreak.tools.lifecycle import (ScriptError, progress, resume_arguments, save_figure,
+                                       time_left, write_atomic)
 from yadebreak.tools.options import read_period_value
 
 
@@ -43,7 +44,7 @@ def single(args):
                    "share_e": mat.energy_partition(target), "results": results,
                    "runtime_s": time.time() - start, "end_reason": end_reason,
                    "end_message": end_message}
-        (out / "summary.json").write_text(json.dumps(summary, indent=2))
+        write_atomic(out / "summary.json", json.dumps(summary, indent=2))
         if results:
             reports.plot_breakage(results, mat, args.size, target,
                                   f"{mat.name}, {1e3 * args.size:g} mm on {args.target}",
@@ -103,7 +104,7 @@ def drop_weight(args):
 
     def write(results, end_reason, end_message):
         """summary.json and, if an energy is done, the plot."""
-        (out / "summary.json").write_text(json.dumps({
+        write_atomic(out / "summary.json", json.dumps({
             "material": mat.name, "size": args.size, "results": results,
             "runtime_s": time.time() - start, "end_reason": end_reason,
             "end_message": end_message}, indent=2))
@@ -231,7 +232,7 @@ def _repeated_outputs(args, mat, share, fractions, brk, out, runtime_s, end_reas
                "expected_absorbed_specific_energy": share * args.energy,
                "runtime_s": runtime_s, "end_reason": end_reason,
                "end_message": end_message}
-    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    write_atomic(out / "summary.json", json.dumps(summary, indent=2))
 
     import matplotlib
     matplotlib.use("Agg")
@@ -250,6 +251,6 @@ def _repeated_outputs(args, mat, share, fractions, brk, out, runtime_s, end_reas
            title=f"{mat.name}, {1e3 * args.size:g} mm at {args.energy:g} J/kg on {args.target}")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(out / "repeated_impact.png", dpi=110)
+    save_figure(fig, out / "repeated_impact.png", dpi=110)
     plt.close(fig)
     return summary

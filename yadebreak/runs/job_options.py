@@ -6,12 +6,13 @@ that one range cannot say. Pure (imports no yade): the tests read a script's opt
 A bad value stops with one line naming the option, the value, the accepted range and the unit
 (exit code 2), before anything is built or written.
 """
-import os
+import math
 
+from yadebreak.model.intervals import BALL_MASS, PARTICLE_SIZE, elastic_wave_speed
 from yadebreak.tools.options import (break_at_option, checkpointed_run_options, choice, fail,
-                                     flag, integer, material_option, number, numbers,
-                                     overwrite_option, read_period_option, script_params,
-                                     size_option, text, time_step_option)
+                                     flag, integer, jobs_option, material_option, number, numbers,
+                                     out_option, overwrite_option, read_period_option,
+                                     script_params, size_option, text, time_step_option)
 
 
 # -- blocks that several jobs share (besides tools.options' material, size, time step, ...) ----
@@ -26,7 +27,7 @@ def laboratory_test(size, middle, out, resume_help, what):
         *middle,
         time_step_option(),
         read_period_option("every_step"),
-        text("out", out, "output folder"),
+        out_option(out),
         flag("resume", False, resume_help),
         overwrite_option(),
         integer("stop_after", 0, f"(tests) end as if killed after this many {what} (0: never)",
@@ -69,7 +70,7 @@ def bed_impact():
         integer("seed", 1, "random seed", lo=0),
         time_step_option(),
         number("dmin", 0.0, "m", "fragments whose progeny would be finer never break "
-               "(0: particle size / 20)", lo=0),
+               "(0: particle size / 20)", lo=0, hi=PARTICLE_SIZE.hi),
         number("stiffness_scale", 1.0, "-", "factor on every Young's modulus (a speed knob; the "
                "paper's is 1)", lo=0, hi=1, lo_open=True),
         number("global_damping", 0.0, "-", "Newton damping of fresh fragments (0: none)", lo=0,
@@ -87,7 +88,47 @@ def bed_impact():
     ]
 
 
+def _wave_speed(material):
+    """sqrt(E/rho) of `material` (a name or a file), or None if it does not load (the run reports
+    why, in its own one line)."""
+    from yadebreak.model.materials import MaterialError, load_material
+    try:
+        mat = load_material(material)
+    except (MaterialError, OSError):
+        return None, None
+    return elastic_wave_speed(mat.young_modulus, mat.density), mat.name
+
+
+def check_impact_speed(option, value, speed, material, unit):
+    """Refuse an impact at or above the elastic wave speed of the particles' material, where Hertz
+    contact means nothing: one line naming the option and its largest accepted value (in `unit`,
+    the option's; the value's speed in m/s)."""
+    limit, name = _wave_speed(material)
+    if limit is None or speed < limit:
+        return
+    bound = {"m/s": limit, "J/kg": 0.5 * limit ** 2, "J": 0.5 * BALL_MASS * limit ** 2}[unit]
+    value = f"{value:g}" if isinstance(value, float) else value
+    fail(f"{option} = {value}: must be < {bound:.4g} ({unit}): it means {speed:.4g} m/s, not below "
+         f"the elastic wave speed sqrt(E/rho) of {name}, {limit:.4g} m/s, where Hertz contact "
+         "means nothing")
+
+
+def _check_specific_energies(args, option):
+    """The particles' speed sqrt(2e) at each specific energy of `option` (J/kg) against their
+    material's wave speed."""
+    value = getattr(args, option)
+    energies = [float(e) for e in str(value).split(",")]
+    e = max(energies)
+    check_impact_speed("--" + option.replace("_", "-"), value, math.sqrt(2.0 * e), args.material,
+                       "J/kg")
+
+
 def _check_bed_impact(args):
+    if args.speed > 0:
+        check_impact_speed("--speed", args.speed, args.speed, args.material, "m/s")
+    else:
+        check_impact_speed("--energy", args.energy, math.sqrt(2.0 * args.energy / BALL_MASS),
+                           args.material, "J")
     if args.dummy_stiffness != 1.0 and args.dummies != "spheres":
         fail(f"--dummy-stiffness = {args.dummy_stiffness:g}: needs --dummies spheres (the "
              "ledger keeps no dummy spheres)")
@@ -120,7 +161,7 @@ def ball_mill():
                "reduction, for a longer time step)", lo=0, hi=1, lo_open=True),
         time_step_option(),
         number("dmin", 0.0, "m", "smallest resolved fragment; finer progeny goes to the ledger "
-               "(0: --size / 3)", lo=0),
+               "(0: --size / 3)", lo=0, hi=PARTICLE_SIZE.hi),
         read_period_option("fast"),
         break_at_option(),
         flag("breakage", True, "0: the spectra run: nothing breaks or is damaged, every stressing "
@@ -182,8 +223,7 @@ def single_impact():
         integer("scene_particles", 1, "particles per scene: independent scenes of at most this "
                 "many, each at the time step of its own finest fragment and ending with its own "
                 "cascade", lo=1),
-        integer("jobs", 1, "YADE processes sharing the scenes (the results do not depend on it; "
-                "this machine has " + str(os.cpu_count()) + " cores)", lo=1, unit="processes"),
+        jobs_option("YADE processes sharing the scenes (the results do not depend on it)"),
         _seed_per_energy(),
         _target_option(),
         numbers("energies", "100,200,400", "J/kg", "specific impact energies Ek/mp = v^2/2",
@@ -222,7 +262,7 @@ def drop_weight():
 
 def extremes():
     return [
-        text("out", "out/extremes", "output folder"),
+        out_option("out/extremes"),
         overwrite_option(),
         flag("fast", False, "the test suite's particle counts"),
         text("only", "", "run the cases whose name contains this text ('': all cases)"),
@@ -234,9 +274,9 @@ JOBS = {
     "bed_impact": (bed_impact, _check_bed_impact),
     "ball_mill": (ball_mill, _check_ball_mill),
     "agglomerate_impact": (agglomerate_impact, None),
-    "single_impact": (single_impact, None),
-    "repeated_impact": (repeated_impact, None),
-    "drop_weight": (drop_weight, None),
+    "single_impact": (single_impact, lambda args: _check_specific_energies(args, "energies")),
+    "repeated_impact": (repeated_impact, lambda args: _check_specific_energies(args, "energy")),
+    "drop_weight": (drop_weight, lambda args: _check_specific_energies(args, "energies")),
     "extremes": (extremes, None),
 }
 

@@ -10,11 +10,8 @@ import numpy as np
 from yadebreak.coupling import add_materials, attach
 from yadebreak.coupling.scene_materials import rolling_friction
 from yadebreak.coupling.yade_api import O, geom, utils
+from yadebreak.model.intervals import BALL_DIAMETER, BALL_MASS  # noqa: F401 (the paper's ball)
 from .impacts import hertz_engines
-
-
-BALL_DIAMETER = 0.088          # m, the paper's steel ball
-BALL_MASS = 2.78               # kg
 
 
 def hex_bed_positions(size, rings, layers=1, gap=0.01):

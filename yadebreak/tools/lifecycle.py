@@ -370,6 +370,19 @@ def write_atomic(path, text):
         raise
 
 
+def save_figure(fig, path, **options):
+    """fig.savefig(path, **options) whole or not at all, as write_atomic (the format from the
+    path's suffix)."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        fig.savefig(tmp, format=path.suffix.lstrip(".") or None, **options)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
 def read_checkpoint(path, load):
     """load(path) for --resume, a damaged checkpoint (truncated, emptied, overwritten) refused in
     one line (ScriptError) before YADE reads it: a gzip file is read through first (its length

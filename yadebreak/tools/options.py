@@ -14,8 +14,10 @@ reads sys.argv. Either way every value is checked against its declaration before
 runs: a bad value stops with one line on stderr naming the option, the value, the accepted range
 and the unit (`[yadebreak] error: --energy = -1: must be > 0 (J)`), exit code 2, as argparse does;
 `--debug 1` shows the traceback instead. Units: plain numbers are SI (m, s, J, J/kg, m/s); the
-option's own unit may follow the number (`--size 5.5mm`, `--energy 3.05J`, `--energies
-100J/kg,200J/kg`), another one is refused.
+option's own unit may follow the number, with or without a space (`--size 5.5mm`, `--size
+"5.5e-3 m"`, `--energy 3.05J`, `--energies 100J/kg,200J/kg`), another one is refused. An option
+whose plain numbers are not SI says so in its unit: "mm" (grind's sizes), "min" (minutes); a
+length unit converts to it (`--feed 8mm`, `--feed "0.008 m"`).
 
 How a run goes once its options are read (exit codes, signals, the lock on --out, checkpoints,
 partial results, finish markers, progress lines) is yadebreak.tools.lifecycle's; the options of
@@ -34,7 +36,10 @@ from yadebreak.model.intervals import PARTICLE_SIZE, Interval
 #: unit of an option -> the units accepted after a number, with their factor to that unit
 UNITS = {
     "m": {"m": "1", "cm": "1e-2", "mm": "1e-3", "um": "1e-6"},
+    "mm": {"mm": "1", "m": "1e3", "cm": "10", "um": "1e-3"},      # plain numbers in millimetres
     "s": {"s": "1", "ms": "1e-3"},
+    "min": {"min": "1", "s": "1/60", "h": "60"},   # plain numbers in minutes
+    "kg": {"kg": "1", "g": "1e-3", "t": "1e3"},
     "J": {"J": "1"},
     "J/kg": {"J/kg": "1"},
     "m/s": {"m/s": "1"},
@@ -66,6 +71,7 @@ class Param:
     lo_open: bool = False
     hi_open: bool = False
     words: tuple = ()          # choice: the accepted words; integer: words accepted besides numbers
+    empty: bool = True         # text: '' accepted (False: an output folder, a list to run)
 
     @property
     def flag(self):
@@ -83,7 +89,7 @@ class Param:
         if self.kind == "choice":
             return " or ".join(repr(w) for w in self.words)
         if self.kind == "text":
-            return "a text"
+            return "a text" if self.empty else "a non-empty text"
         interval = str(self.interval)
         if self.kind == "integer":
             interval = "an integer" + ("" if interval == "any number" else f" {interval}")
@@ -142,9 +148,7 @@ class Param:
             own = ", ".join(factors) if factors else "none"
             raise self._error(shown, f"; {'the unit ' if known else ''}{unit!r} is not accepted "
                                      f"here (units accepted: {own})")
-        if factors[unit] == "1":
-            return float(number)
-        return float(Decimal(number) * Decimal(factors[unit]))
+        return scaled(number, factors[unit])
 
     def convert(self, value):
         """The checked value of this option from a command-line text or a yade-batch table value;
@@ -153,6 +157,8 @@ class Param:
         if value is None and self.default is None:     # a default of None: "not given"
             return None
         if self.kind == "text":
+            if not self.empty and not str(value).strip():
+                raise self._error(repr(str(value)))
             return str(value)
         if self.kind == "flag":
             if isinstance(value, bool):
@@ -212,6 +218,22 @@ class Param:
         return value
 
 
+def scaled(number, factor):
+    """float(number) times a factor of UNITS ("1e-3", or a ratio "1/60"), exactly in decimal."""
+    if factor == "1":
+        return float(number)
+    top, _, bottom = factor.partition("/")
+    return float(Decimal(number) * Decimal(top) / Decimal(bottom or "1"))
+
+
+def number_and_unit(text):
+    """('8', 'mm') of '8mm' or '8 mm', ('5.5', '') of '5.5'; None if `text` is no number."""
+    if _is_float(text):
+        return text.strip(), ""
+    match = _NUMBER_THEN_UNIT.match(text)
+    return match.groups() if match else None
+
+
 def _is_float(text):
     try:
         float(text)
@@ -244,8 +266,29 @@ def flag(name, default, help):
     return Param(name, default, "flag", help=help)
 
 
-def text(name, default, help):
-    return Param(name, default, "text", help=help)
+def text(name, default, help, empty=True):
+    """A text; empty=False refuses '' (and blanks)."""
+    return Param(name, default, "text", help=help, empty=empty)
+
+
+def out_option(default, help="output folder"):
+    """--out: a folder to write in ('' would be the current folder: refused)."""
+    return text("out", default, help, empty=False)
+
+
+def usable_cores():
+    """The cores this process may use (its CPU affinity): the default of every --jobs that
+    counts processes on this machine."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:                         # no affinity on this system
+        return os.cpu_count() or 1
+
+
+def jobs_option(help):
+    """--jobs: processes on this machine sharing the work; the results do not depend on it."""
+    return integer("jobs", usable_cores(), help + " (default: the cores this process may use)",
+                   lo=1, unit="processes")
 
 
 DEBUG = flag("debug", False, "show the traceback of an error instead of its one line")
@@ -305,7 +348,7 @@ def checkpointed_run_options(vtk_interval, out):
         overwrite_option(),
         number("stop_after", 0.0, "s", "(tests) end as if killed at this simulated time "
                "(0: never)", lo=0),
-        text("out", out, "output folder"),
+        out_option(out),
     ]
 
 
@@ -389,7 +432,12 @@ def script_params(params, description=None, argv=None, table_row=None):
             fail("under yade-batch the options come from the table's row: pass "
                  "table_row=yadebreak.coupling.yade_api.table_row to script_params")
         defaults = {p.name: p.default for p in params}
-        row, description = table_row(defaults)
+        try:
+            row, description = table_row(defaults)
+        except NameError as exc:  # readParamsFromTable: a column without a default
+            column = re.search(r"`(\w+)'", str(exc))
+            fail(f"the table's column {column.group(1) if column else str(exc)!r} is not an option "
+                 f"of this script (its options: {', '.join(sorted(defaults))})")
         values = argparse.Namespace(**row)
         read_params(values, params)
         if "out" in defaults and values.out == defaults["out"] and description:

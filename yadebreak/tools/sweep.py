@@ -17,6 +17,7 @@ The table reader and the status file need no Dask; Dask is imported when a sweep
 from __future__ import annotations
 
 import csv
+import io
 import datetime
 import json
 import math
@@ -30,6 +31,8 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from yadebreak.tools.lifecycle import write_atomic
 
 #: the exit code of a yadebreak script refusing its options (never retried)
 USER_ERROR = 2
@@ -423,10 +426,11 @@ def gather(out, lines):
         columns += [k for k in row if k not in columns]
     path = out / "sweep.csv"
     out.mkdir(parents=True, exist_ok=True)
-    with open(path, "w", newline="") as f:
-        writer = csv.DictWriter(f, columns, restval="")
-        writer.writeheader()
-        writer.writerows({k: _cell(v) for k, v in row.items()} for row in rows)
+    table = io.StringIO(newline="")
+    writer = csv.DictWriter(table, columns, restval="")
+    writer.writeheader()
+    writer.writerows({k: _cell(v) for k, v in row.items()} for row in rows)
+    write_atomic(path, table.getvalue())
     return path
 
 

@@ -18,6 +18,7 @@ The statistics (no Dask, no YADE) are the functions below; run() drives the runs
 from __future__ import annotations
 
 import csv
+import io
 import itertools
 import json
 import math
@@ -29,6 +30,7 @@ import numpy as np
 from scipy import stats
 
 from yadebreak.tools import sweep
+from yadebreak.tools.lifecycle import save_figure, write_atomic
 
 #: confidence level of the intervals
 LEVEL = 0.95
@@ -236,10 +238,11 @@ def write_outputs(rows, metrics, out, title):
     """tradeoff.csv, tradeoff.md and pareto.png into `out`."""
     out = Path(out)
     columns = list(rows[0])
-    with open(out / "tradeoff.csv", "w", newline="") as f:
-        writer = csv.DictWriter(f, columns)
-        writer.writeheader()
-        writer.writerows(rows)
+    table = io.StringIO(newline="")
+    writer = csv.DictWriter(table, columns)
+    writer.writeheader()
+    writer.writerows(rows)
+    write_atomic(out / "tradeoff.csv", table.getvalue())
     lines = [f"# {title}", "",
              "Paired over common seeds; diff = the variant's mean minus the reference's (a list "
              "metric: the RMS of the mean difference), with its 95 % interval; 'yes' where the "
@@ -262,7 +265,7 @@ def write_outputs(rows, metrics, out, title):
                      f"[{_g(r[f'{key}:ci_low'])}, {_g(r[f'{key}:ci_high'])}] | "
                      f"{'yes' if r[f'{key}:distinguishable'] else 'no'} |")
         lines.append(line)
-    (out / "tradeoff.md").write_text("\n".join(lines) + "\n")
+    write_atomic(out / "tradeoff.md", "\n".join(lines) + "\n")
     plot_pareto(rows, metrics, out / "pareto.png", title)
 
 
@@ -317,7 +320,7 @@ def plot_pareto(rows, metrics, path, title):
              family="monospace")
     fig.suptitle(title, fontsize=10)
     fig.tight_layout(rect=(0, 0, 1 - key_width, 0.95))
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
 
 

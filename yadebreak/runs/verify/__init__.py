@@ -48,9 +48,10 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from yadebreak.model.materials import load_material
+from yadebreak.model.materials import MaterialError, load_material
 from yadebreak.tools.lifecycle import progress
-from yadebreak.tools.options import break_at_option, integer, number, numbers, text
+from yadebreak.tools.options import (break_at_option, integer, jobs_option, number, numbers,
+                                     out_option, text)
 from . import fragmentation, probability
 from .report import write_report
 from .settings import (PAPER_MATERIALS, Runner, paper_material, plan,  # noqa: F401
@@ -72,8 +73,9 @@ PARAMS = [
     integer("quick", 0, "1: the quick subset (copper ore, few particles, 2-3 energies; under 3 "
             "minutes)", lo=0, hi=1),
     text("figures", ",".join(DEFAULT_FIGURES),
-         "figures to run, comma-separated: " + ", ".join(FIGURES)),
-    text("materials", ",".join(PAPER_MATERIALS), "materials of Figs. 8 and 16 (names or files)"),
+         "figures to run, comma-separated: " + ", ".join(FIGURES), empty=False),
+    text("materials", ",".join(PAPER_MATERIALS), "materials of Figs. 8 and 16 (names or files)",
+         empty=False),
     numbers("energies", "150,300,1000,3000", "J/kg",
             "specific energies Ek/mp of Figs. 13-16 (quick: 1000; Figs. 17-19: 300 and 3000)",
             lo=0, lo_open=True),
@@ -93,8 +95,8 @@ PARAMS = [
     number("dummy_stiffness", 1.0, "-", "Young's modulus of the dummy spheres in Figs. 13-19 as "
            "a share of the ore's (an option beyond the paper, which allows a softer dummy class; "
            "1: the ore's)", lo=0, hi=1, lo_open=True),
-    integer("jobs", 1, "YADE processes sharing each run's scenes", lo=1, unit="processes"),
-    text("out", "out/verify", "output folder"),
+    jobs_option("YADE processes sharing each run's scenes"),
+    out_option("out/verify"),
 ]
 
 
@@ -104,11 +106,11 @@ def verify(args):
     import sys
     began = time.time()
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     wanted = [f.strip() for f in args.figures.split(",") if f.strip()]
     unknown = [f for f in wanted if f not in FIGURES]
-    if unknown:
-        fail(f"--figures = {args.figures}: unknown {unknown}; accepted {', '.join(FIGURES)}")
+    if unknown or not wanted:
+        fail(f"--figures = {args.figures!r}: " + (f"unknown {unknown}" if unknown else
+             "names no figure") + f"; accepted {', '.join(FIGURES)}")
     args.material_list = (["copper_ore"] if args.quick else
                           [m.strip() for m in args.materials.split(",") if m.strip()])
     args.energy_list = [float(e) for e in args.energies.split(",")]
@@ -119,8 +121,14 @@ def verify(args):
     if args.read_period not in ("every_step", "fast"):
         fail(f"--read-period = {args.read_period}: accepted every_step or fast")
     args.argv = getattr(args, "argv", None) or sys.argv[2:]
-    for name in args.material_list:
-        load_material(name)                   # a bad name stops here, before any run
+    for name in args.material_list:           # a bad name stops here, before any run
+        try:
+            load_material(name)
+        except MaterialError as exc:
+            if getattr(args, "debug", False):
+                raise
+            fail(f"--materials = {args.materials}: " + "; ".join(exc.problems))
+    out.mkdir(parents=True, exist_ok=True)
     runner = Runner(args.jobs)
     makers = [make for name, make in FIGURES.items() if name in wanted]
     try:

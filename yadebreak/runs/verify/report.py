@@ -19,7 +19,8 @@ def save(fig, path, settings):
     lines = wrapped.count("\n") + 1
     fig.tight_layout(rect=(0, 0.035 * lines + 0.02, 1, 1))
     fig.text(0.01, 0.01, wrapped, fontsize=7, va="bottom")
-    fig.savefig(path, dpi=110)
+    from yadebreak.tools.lifecycle import save_figure
+    save_figure(fig, path, dpi=110)
     plt_module().close(fig)
     return path
 
@@ -50,7 +51,8 @@ def write_report(out, figures, runner, args, wall):
         lines += [f"- {c['what']}: {c['detail']} ({'met' if c['ok'] else '**not met**'})"
                   for c in f["checks"] if "detail" in c]
         lines.append("")
-    (out / "report.md").write_text("\n".join(lines))
-    (out / "results.json").write_text(json.dumps(
+    from yadebreak.tools.lifecycle import write_atomic
+    write_atomic(out / "report.md", "\n".join(lines))
+    write_atomic(out / "results.json", json.dumps(
         {"argv": args.argv, "wall_s": wall, "figures": figures,
          "runs": list(runner.results.values())}, indent=1, default=float))

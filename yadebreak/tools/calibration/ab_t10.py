@@ -19,7 +19,7 @@ import numpy as np
 from scipy import optimize, stats
 
 from yadebreak import model
-from .mle import CHI2_95, Coord, Estimate, FitError, MLResult
+from .mle import CHI2_95, Coord, Estimate, FitError, MLResult, require
 
 CHI2_95_2DOF = float(stats.chi2.ppf(0.95, 2))
 COORDS = [Coord("e_min_ref", "J/kg", "identity", 0.0, math.inf),
@@ -45,6 +45,7 @@ def fit_ab_t10(table, device, size_ref_mm, intervals=True):
     """Fit e_min,ref and S to a fracture Table; returns an MLResult (estimates by name)."""
     size_mm, energy = table.columns["size"], table.columns["energy"]
     broken = table.columns.get("broken", np.ones(len(table))) == 1
+    require(["e_min_ref", "selection"], int(broken.sum()), "particles that broke", table.path, 3)
     # the largest e_min,ref with every broken particle at or above 2 e_min(L)
     # (less a relative 1e-12, so that round-off keeps that particle on the allowed side)
     e_hat = float(np.min(device.share * energy[broken] * size_mm[broken])

@@ -9,8 +9,10 @@ import sys
 import time
 from pathlib import Path
 
+from yadebreak.model.intervals import Interval, elastic_wave_speed
 from yadebreak.model.materials import MaterialError, load_material
-from yadebreak.tools.options import ScriptParser, fail
+from yadebreak.tools.lifecycle import write_atomic
+from yadebreak.tools.options import ScriptParser, fail, out_option, read_params
 from yadebreak.tools.calibration import data, outputs
 from .fit import apply_bootstrap, bootstrap, fit_all
 from .mle import FitError
@@ -42,6 +44,7 @@ def _whole(text, option, lo):
 
 def main(argv=None):
     args = parser().parse_args(sys.argv[1:] if argv is None else argv)
+    read_params(args, [out_option(None)])
     replicates = _whole(args.bootstrap, "bootstrap", 0)
     seed = _whole(args.seed, "seed", 0)
     if not args.name.replace("_", "").replace("-", "").isalnum():
@@ -58,6 +61,12 @@ def run(args, replicates, seed):
     start = time.perf_counter()
     base = load_material(args.base) if args.base else None
     by_kind = data.read_tables(args.data)
+    if base is not None:                  # its own wave speed bounds the impact energies
+        speed = elastic_wave_speed(base.young_modulus, base.density)
+        for table in (t for ts in by_kind.values() for t in ts if "energy" in t.columns):
+            data.within(table, "energy", Interval(0.0, 0.5 * speed ** 2, True, True), "J/kg",
+                        f": v = sqrt(2 Ek/mp) must stay below the elastic wave speed sqrt(E/rho) "
+                        f"of --base {base.name}, {speed:.4g} m/s")
     tables = {kind: data.concat(ts) for kind, ts in by_kind.items()}
     cal = fit_all(tables, args.model, base)
     timings = {"fit with profile intervals": time.perf_counter() - start}
@@ -75,7 +84,7 @@ def run(args, replicates, seed):
     text = outputs.material_text(cal, args.name, [str(p) for p in args.data])
     if text is not None:
         path = out / f"{args.name}.toml"
-        path.write_text(text)
+        write_atomic(path, text)
         try:
             load_material(path)
         except MaterialError as exc:
@@ -84,7 +93,7 @@ def run(args, replicates, seed):
                 from None
     figures = outputs.plots(cal, out)
     outputs.write_json(cal, out / "fit.json", {"timings_s": timings})
-    (out / "report.md").write_text(outputs.report_text(cal, figures, timings))
+    write_atomic(out / "report.md", outputs.report_text(cal, figures, timings))
     for k, e in cal.estimates.items():
         print(f"[yadebreak] {k} = {e.value:.4g} {e.unit}, 95 % [{e.lo:.4g}, {e.hi:.4g}]")
     print(f"[yadebreak] wrote {out / 'fit.json'}, {out / 'report.md'}"

@@ -16,7 +16,7 @@ import numpy as np
 from scipy import stats
 
 from yadebreak import model
-from .mle import Coord, fit
+from .mle import Coord, fit, require
 
 #: the Hessian's step in ln gamma spans many quadrature points (F_k is interpolated between them)
 COORDS = [Coord("gamma", "-", "log", math.log(0.2), math.log(200.0), step=0.02)]
@@ -56,6 +56,8 @@ def fit_gamma(table, fracture_params, device, intervals=True, start=None):
     """Fit gamma to a repeated-impacts Table; returns the MLResult (extra: per series the counts,
     the fitted F_k and a deviance goodness-of-fit test). start: a gamma to search around (the
     full data's, for a bootstrap replicate) instead of a scan."""
+    require(["gamma"], int(np.count_nonzero(table.columns["impact"] >= 2)),
+            "rows of impacts after the first (damage shows only there)", table.path, 1)
     groups = series(table)
 
     def nll(x):

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak import model
-from yadebreak.model.intervals import InputError
+from yadebreak.model.intervals import PARTICLE_SIZE, SPECIFIC_ENERGY, InputError
 
 #: column name (lower case) -> (quantity, factor to the unit used here: mm, J/kg, %, J, kg)
 COLUMNS = {
@@ -153,6 +153,15 @@ def _check_common(table):
         _check_positive(table, "mass", "kg")
     _check_positive(table, "size", "mm")
     _check_positive(table, "energy", "J/kg")
+    within(table, "size", PARTICLE_SIZE.scaled(1e-3), "mm")
+    within(table, "energy", SPECIFIC_ENERGY, "J/kg")
+
+
+def within(table, quantity, interval, unit, why=""):
+    """Every value of `quantity` in `interval` (its unit `unit`), or DataError at the first."""
+    values = table.columns[quantity]
+    _bad(table, ~np.array([v in interval for v in values], bool), quantity,
+         f"must be {interval} ({unit}){why}")
 
 
 def _check_fracture(table):

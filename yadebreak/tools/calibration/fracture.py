@@ -19,7 +19,7 @@ from scipy import stats
 
 from yadebreak import model
 from yadebreak.model.intervals import PARTICLE_SIZE
-from .mle import Coord, FitError, fit
+from .mle import Coord, FitError, fit, require
 
 #: the fitted coordinates: ln Einf, ln d0 (mm), phi, ln sigma, ln(E50/Emax) (Emax/E50 up to 1e4)
 COORDS = {
@@ -124,6 +124,7 @@ def fit_fracture(table, device=Device(), fixed=None, intervals=True):
                        f"at least {MIN_CLASSES} are needed to fit them (or give --base to take "
                        "them from a material)")
     names = [n for n in COORDS if n not in fixed]
+    require(names, int(broken.sum()), "particles that broke", table.path, len(names) + 1)
     coords = [COORDS[n] for n in names]
     starts = [{**s, **fixed} for s in _starts(size_mm, energy, broken, fixed)]
 

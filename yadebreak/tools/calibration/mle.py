@@ -20,6 +20,14 @@ CHI2_95 = float(stats.chi2.ppf(0.95, 1))
 INFEASIBLE = 1e299
 
 
+def require(names, count, what, path, needed):
+    """Refuse a relation the data cannot determine: `count` `what` (particles that broke, energy
+    levels, ...) in `path` for the parameters `names`, fewer than `needed`."""
+    if count < needed:
+        raise FitError(f"parameters {', '.join(names)}: {count} {what} in {path}, at least "
+                       f"{needed} are needed to determine them")
+
+
 class FitError(ValueError):
     """A fit that cannot be made or did not converge: the message names the parameter and why."""
 

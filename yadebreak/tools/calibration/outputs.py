@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-
+from yadebreak.tools.lifecycle import save_figure, write_atomic
 from .fit import AB_T10_KEYS, TAVARES_KEYS
 
 UNITS = {"e_inf": "J/kg", "d0": "mm", "phi": "-", "sigma": "-", "emax_ratio": "-", "gamma": "-",
@@ -72,7 +72,7 @@ def fit_json(cal, extra=None):
 
 
 def write_json(cal, path, extra=None):
-    Path(path).write_text(json.dumps(fit_json(cal, extra), indent=2, default=_plain))
+    write_atomic(path, json.dumps(fit_json(cal, extra), indent=2, default=_plain))
 
 
 def _plain(v):
@@ -166,7 +166,7 @@ def plots(cal, out):
             continue
         path = Path(out) / f"{name}.png"
         fig.tight_layout()
-        fig.savefig(path, dpi=100)
+        save_figure(fig, path, dpi=100)
         plt.close(fig)
         paths.append(path)
     return paths

@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from yadebreak import model
-from .mle import Coord, least_squares
+from .mle import Coord, least_squares, require
 
 COORDS = [Coord("A", "%", "identity", 0.1, 100.0),
           Coord("b_prime", "-", "log", math.log(1e-5), math.log(10.0))]
@@ -37,6 +37,8 @@ def fit_t10(table, fracture_params, device, intervals=True):
     e50b_rows, absorbed = e50b(table, fracture_params, device)
     t10 = table.columns["t10"]
     ok = np.isfinite(e50b_rows)
+    levels = len(set(zip(table.columns["size"][ok], table.columns["energy"][ok])))
+    require(["A", "b_prime"], levels, "energy levels (size and energy)", table.path, 2)
 
     def residuals(x):
         return t10[ok] - model.t10_batch(absorbed[ok], e50b_rows[ok], x[0], math.exp(x[1]))

@@ -5,14 +5,17 @@ or file."""
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 from pathlib import Path
 
 import numpy as np
 
+from yadebreak.model.intervals import PARTICLE_SIZE
 from yadebreak.model.materials import load_material
-from yadebreak.tools.lifecycle import progress
+from yadebreak.tools.lifecycle import progress, save_figure, write_atomic
+from yadebreak.tools.options import UNITS, ParamError, number, number_and_unit
 from .classes import (FeedError, class_label, feed_masses, feed_top_sieve, read_psd_csv,
                       root2_classes)
 from .population import BatchGrinder, GrindingError
@@ -50,16 +53,21 @@ def load_spectra(source, out):
     return read_spectra(source), source
 
 
+#: --feed as a size: plain numbers in mm, a length unit may follow, within the particle sizes
+FEED_SIZE = number("feed", 5.5, "mm", "", lo=PARTICLE_SIZE.lo * 1e3, hi=PARTICLE_SIZE.hi * 1e3)
+
+
 def parse_feed(text_value):
-    """--feed: a size in mm (a single-size feed) or a CSV file (size_mm, passing_percent).
-    Returns a size in m or (sizes m, passing %)."""
-    try:
-        size_mm = float(text_value)
-    except ValueError:
+    """--feed: a size (a single-size feed: a plain number in mm, or a number with a length unit:
+    8mm, '0.008 m') or else a CSV file (size_mm, passing_percent). Returns a size in m or
+    (sizes m, passing %)."""
+    parts = number_and_unit(text_value)
+    if parts is None or parts[1] not in ("", *UNITS["mm"]):
         return read_psd_csv(text_value)
-    if not (math.isfinite(size_mm) and size_mm > 0):
-        raise FeedError(f"--feed = {text_value}: accepted a size > 0 (mm) or a CSV file")
-    return size_mm * 1e-3
+    try:
+        return FEED_SIZE.convert(text_value) * 1e-3
+    except ParamError as exc:
+        raise FeedError(f"{exc} or a CSV file") from None
 
 
 def grind(args):
@@ -106,27 +114,30 @@ def _p80(sieves, passing):
     return float(np.exp(np.interp(80.0, asc_p, np.log(asc_s))))
 
 
+def _write_csv(path, header, rows):
+    """A CSV file written whole or not at all (write_atomic)."""
+    text = io.StringIO(newline="")
+    w = csv.writer(text)
+    w.writerow(header)
+    w.writerows(rows)
+    write_atomic(path, text.getvalue())
+
+
 def _write(out, args, material, spectra_path, spectra, classes, result, s0, holdup):
     minutes = result.times_s / 60.0
     passing = result.passing_percent
     sieves = classes.sieves
-    with open(out / "psd.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["minutes", "size_mm", "passing_percent"])
-        for t, row in zip(minutes, passing):
-            w.writerows([t, 1e3 * s, p] for s, p in zip(sieves, row))
-    with open(out / "breakage_rate.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["minutes", "class_upper_mm", "class_lower_mm", "mass_kg",
-                    "breakage_rate_per_min"])
-        for t, mass, rate in zip(minutes, result.masses, result.rates):
-            w.writerows([t, 1e3 * sieves[k], 1e3 * sieves[k + 1], mass[k], 60.0 * rate[k]]
-                        for k in range(classes.count))
-    with open(out / "energy.csv", "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["minutes", "collision_energy_kWh_per_t", "absorbed_energy_kWh_per_t"])
-        w.writerows(zip(minutes, result.collision_energy_J_per_kg / 3600.0,
-                        result.absorbed_energy_J_per_kg / 3600.0))
+    _write_csv(out / "psd.csv", ["minutes", "size_mm", "passing_percent"],
+               [[t, 1e3 * s, p] for t, row in zip(minutes, passing) for s, p in zip(sieves, row)])
+    _write_csv(out / "breakage_rate.csv", ["minutes", "class_upper_mm", "class_lower_mm",
+                                           "mass_kg", "breakage_rate_per_min"],
+               [[t, 1e3 * sieves[k], 1e3 * sieves[k + 1], mass[k], 60.0 * rate[k]]
+                for t, mass, rate in zip(minutes, result.masses, result.rates)
+                for k in range(classes.count)])
+    _write_csv(out / "energy.csv", ["minutes", "collision_energy_kWh_per_t",
+                                    "absorbed_energy_kWh_per_t"],
+               zip(minutes, result.collision_energy_J_per_kg / 3600.0,
+                   result.absorbed_energy_J_per_kg / 3600.0))
     summary = {
         "material": material.name, "spectra": str(spectra_path), "spectra_source": spectra.source,
         "feed": args.feed, "minutes": args.minutes, "mode": "continuous" if args.residence > 0
@@ -144,7 +155,7 @@ def _write(out, args, material, spectra_path, spectra, classes, result, s0, hold
         "discharged_mass": result.discharged_mass,
         "mass_relative_error": result.mass_relative_error, "steps": result.steps,
         "runtime_s": result.runtime_s}
-    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    write_atomic(out / "summary.json", json.dumps(summary, indent=2))
     _plot(out, material, classes, result, s0)
     return summary
 
@@ -179,7 +190,7 @@ def _plot(out, material, classes, result, s0):
     axes[2].set(xlabel="minutes", ylabel="breakage rate (1/min)", title="breakage rate per class")
     axes[2].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(out / "grind.png", dpi=110)
+    save_figure(fig, out / "grind.png", dpi=110)
     plt.close(fig)
 
 

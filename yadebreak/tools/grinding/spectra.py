@@ -75,15 +75,18 @@ class Spectra:
 
 
 def write_spectra(path, spectra):
-    """Write `spectra` in the file format above."""
+    """Write `spectra` in the file format above (whole or not at all)."""
+    import io
+    from yadebreak.tools.lifecycle import write_atomic
     path = Path(path)
-    with open(path, "w", newline="") as f:
-        f.write("# " + json.dumps(spectra.metadata()) + "\n")
-        w = csv.writer(f)
-        w.writerow(COLUMNS)
-        for row in zip(spectra.pair_type, spectra.energy_low_J, spectra.energy_high_J,
-                       spectra.events):
-            w.writerow([row[0]] + [repr(float(v)) for v in row[1:]])
+    f = io.StringIO(newline="")
+    f.write("# " + json.dumps(spectra.metadata()) + "\n")
+    w = csv.writer(f)
+    w.writerow(COLUMNS)
+    for row in zip(spectra.pair_type, spectra.energy_low_J, spectra.energy_high_J,
+                   spectra.events):
+        w.writerow([row[0]] + [repr(float(v)) for v in row[1:]])
+    write_atomic(path, f.getvalue())
     return path
 
 

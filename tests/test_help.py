@@ -1,0 +1,54 @@
+"""--help of every `python3 -m yadebreak` command and every script in scripts/: exit code 0 and the
+options listed. In-process (the scripts' options through job_options, as the scripts read them),
+but for three subprocesses: the module's and tradeoff's help as users run them, and
+gather_sweep.py (plain Python)."""
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from yadebreak import __main__ as cli
+from yadebreak.runs import job_options
+
+ROOT = Path(__file__).resolve().parent.parent
+PYTHON = "/usr/bin/python3"
+COMMANDS = [*cli.COMMANDS, "tradeoff", "fit", "verify"]
+
+
+def _help(capsys, read):
+    with pytest.raises(SystemExit) as end:
+        read()
+    assert end.value.code in (0, None)
+    return capsys.readouterr().out
+
+
+def test_every_script_is_covered():
+    assert {p.stem for p in (ROOT / "scripts").glob("*.py")} == set(job_options.JOBS) | {
+        "gather_sweep"}
+
+
+@pytest.mark.parametrize("job", sorted(job_options.JOBS))
+def test_script_help(capsys, job):
+    doc = (ROOT / "scripts" / f"{job}.py").read_text().split('"""')[1]
+    said = _help(capsys, lambda: job_options.read(job, doc, ["--help"]))
+    assert "--out" in said and "--debug" in said, said
+    for p in job_options.JOBS[job][0]():
+        assert p.flag in said
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_command_help(capsys, command):
+    said = _help(capsys, lambda: cli.main([command, "--help"]))
+    assert f"{command}" in said and "--" in said, said
+
+
+def test_help_of_the_module_and_of_tradeoff_and_gather_sweep_as_run():
+    for command in ([PYTHON, "-m", "yadebreak", "--help"],
+                    [PYTHON, "-m", "yadebreak", "tradeoff", "--help"],
+                    [PYTHON, str(ROOT / "scripts" / "gather_sweep.py"), "--help"]):
+        proc = subprocess.run(command, capture_output=True, text=True, timeout=120, cwd=ROOT)
+        assert proc.returncode == 0 and proc.stderr == "", (command, proc.stderr[-1000:])
+        assert "--" in proc.stdout
+    said = subprocess.run([PYTHON, "-m", "yadebreak", "tradeoff", "--help"], capture_output=True,
+                          text=True, timeout=120, cwd=ROOT).stdout
+    assert "with a 95 %\ninterval" in said                 # its usage's % as written
