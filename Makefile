@@ -41,7 +41,7 @@ demo: deps
 
 # The model alone (no YADE): breakage probability, t10 and progeny curves of a material.
 model-demo:
-	$(PY) -m yadebreak demo --out $(OUT)/model_demo
+	$(PY) -m yadebreak demo --out $(OUT)/model_demo --overwrite 1
 
 test: deps
 	$(PY) -m pytest -q -n auto tests

@@ -620,5 +620,26 @@ def test_a_read_only_out_ends_a_command_in_one_line(tmp_path, capsys, monkeypatc
         with pytest.raises(SystemExit) as end:
             main([*command, "--out", str(out)])
         err = capsys.readouterr().err.strip().splitlines()
-        assert end.value.code == 1 and err == [f"[yadebreak] error: cannot write {out}: Read-only "
-                                               f"file system; nothing was written in {out}"], err
+        assert end.value.code == 1 and err == [f"[yadebreak] error: --out = {out}: cannot be "
+                                               f"written (OSError: [Errno 30] Read-only file "
+                                               f"system: '{out}'); nothing was run"], err
+
+
+def test_a_command_run_again_into_its_out_is_refused_until_overwrite(tmp_path, capsys):
+    """The commands that write a run folder (demo here; grind, fit and verify alike) keep a
+    finished run: run again into it, one line and exit code 2, its files untouched."""
+    from yadebreak.__main__ import main
+    out = tmp_path / "demo"
+    assert main(["demo", "--out", str(out)]) == 0
+    assert (out / "finished.json").is_file()
+    kept = {p.name: p.read_bytes() for p in out.iterdir()}
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as end:
+        main(["demo", "--out", str(out), "--material", "granulite"])
+    line = _one_line(capsys.readouterr().err)
+    assert end.value.code == 2 and line == (
+        f"[yadebreak] error: --out = {out} holds a finished run (finished.json): start it over "
+        "with --overwrite 1, or choose another --out")
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == kept
+    assert main(["demo", "--out", str(out), "--material", "granulite", "--overwrite", "1"]) == 0
+    assert (out / "model_granulite.png").is_file()

@@ -446,7 +446,8 @@ def test_grind_on_a_full_disk_ends_in_one_line_and_leaves_whole_files(tmp_path, 
     err = [line for line in capsys.readouterr().err.splitlines() if "error" in line]
     assert err == ["[yadebreak] error: cannot write: No space left on device; kept in "
                    f"{out}: breakage_rate.csv, psd.csv, spectra.csv"]
-    assert sorted(p.name for p in out.iterdir()) == ["breakage_rate.csv", "psd.csv", "spectra.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [".yadebreak.lock", "breakage_rate.csv",
+                                                     "psd.csv", "spectra.csv"]   # the run's lock
     with open(out / "psd.csv") as f:
         rows = list(csv.DictReader(f))
     assert sorted({float(r["minutes"]) for r in rows}) == [0.0, 0.5, 1.0]     # whole

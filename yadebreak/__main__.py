@@ -9,16 +9,18 @@ from __future__ import annotations
 import json
 import sys
 import time
+from contextlib import nullcontext
 from pathlib import Path
 
 import numpy as np
 
 from yadebreak.model import families
-from yadebreak.tools.lifecycle import save_figure, write_atomic
+from yadebreak.tools.lifecycle import LOCK, save_figure, tool_run, write_atomic
 from yadebreak import model
 from yadebreak.model.materials import MaterialError, available_materials, load_material
 from yadebreak.tools.options import (DEBUG, ScriptParser, add_params, fail, integer,
-                                     join_negative_values, number, out_option, read_params, text)
+                                     join_negative_values, number, out_option, overwrite_option,
+                                     read_params, text)
 
 
 def _plt():
@@ -220,7 +222,7 @@ def _grind(args):
 COMMANDS = {
     "demo": (demo, "plot breakage probability and t10 curves of a material", [
         text("material", "copper_ore", "a material name or a .toml file"),
-        out_option("out/demo")]),
+        out_option("out/demo"), overwrite_option()]),
     "families": (plot_families, "plot the family set of a t10' (paper Fig. 2)", [
         text("material", "table1", "a material name, or table1"),
         number("t10", 3.0, "%", "t10' of the family set", lo=0, lo_open=True, hi=100),
@@ -254,7 +256,7 @@ COMMANDS = {
         number("holdup", 0.0, "kg", "ore in the mill (0: the spectra's ore mass)", lo=0),
         number("residence", 0.0, "min", "mean residence time of a continuous mill (0: batch)",
                lo=0),
-        out_option("out/grind")],
+        out_option("out/grind"), overwrite_option()],
         [("spectra", "a spectra file, a mill run's --out folder (converted) or "
           "synthetic:BALL_MM (docs/grinding.md)")]),
 }
@@ -281,7 +283,7 @@ def _kept(out, since):
     if folder is None or not folder.is_dir():
         return f"nothing was written in {out}" if out else "nothing was written"
     new = sorted(str(p.relative_to(folder)) for p in folder.rglob("*")
-                 if p.is_file() and p.stat().st_mtime >= since - 1.0)
+                 if p.is_file() and p.name != LOCK and p.stat().st_mtime >= since - 1.0)
     if not new:
         return f"nothing was written in {folder}"
     shown = ", ".join(new[:6]) + (f" and {len(new) - 6} more" if len(new) > 6 else "")
@@ -333,8 +335,10 @@ def main(argv=None):
     every = [p for _, _, params, *_ in COMMANDS.values() for p in params]
     args = parser.parse_args(join_negative_values(argv, every))
     read_params(args, args.params)
+    owns_out = any(p.name == "overwrite" for p in args.params)     # a run folder of its own
     try:
-        return args.func(args) or 0
+        with tool_run(args.out, args) if owns_out else nullcontext():
+            return args.func(args) or 0
     except MaterialError as exc:
         if args.debug:
             raise

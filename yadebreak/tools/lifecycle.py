@@ -17,7 +17,7 @@ import sys
 import time
 import traceback
 import warnings
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
 from yadebreak.model.intervals import InputError
@@ -51,17 +51,9 @@ def run_script(main, *args):
     close_remote_access()
     out = getattr(args[0], "out", None) if args else None
     began = time.time()
-    handlers, locked = _catch_signals(), False
-    fresh = out is not None and not Path(out).exists()     # made by the lock: gone if unused
+    handlers = _catch_signals()
     try:
-        left = None if fresh or out is None else run_left_in(out)    # before our own lock
-        try:
-            locked = out is not None and lock_out(out, lambda: claim_out(out, args[0], left))
-        except OSError as exc:           # a read-only or full disk, --out naming a file
-            print(f"[yadebreak] error: --out = {out}: cannot be written ({error_line(exc)}); "
-                  "nothing was run", file=sys.stderr, flush=True)
-            raise SystemExit(1) from None
-        with warnings_shown_once():
+        with (nullcontext() if out is None else own_out(out, args[0])), warnings_shown_once():
             return main(*args)
     except StopRequested:
         raise SystemExit(0) from None
@@ -91,12 +83,6 @@ def run_script(main, *args):
         raise SystemExit(1) from None
     finally:
         _restore_signals(handlers)
-        if locked:                       # the run is over (a YADE prompt may follow)
-            _LOCKS.pop(str(Path(out).resolve())).close()
-            if [p.name for p in Path(out).iterdir()] == [LOCK]:
-                (Path(out) / LOCK).unlink()        # refused before writing: leave nothing
-                if fresh:
-                    Path(out).rmdir()
     fail(message)
 
 
@@ -208,6 +194,47 @@ def run_left_in(out):
     return None
 
 
+@contextmanager
+def own_out(out, args):
+    """Hold the folder `out` for one run (of a script or a tool): locked against a second run
+    (lock_out), a new run over an earlier one refused (claim_out; ScriptError), an --out that
+    cannot be written (a file, a read-only or full disk) ended in one line and exit code 1
+    before anything runs; on leaving, the lock is released, and a folder the run left holding
+    only its lock is left as it was found (removed if this run made it)."""
+    fresh = not Path(out).exists()
+    left = None if fresh else run_left_in(out)            # read before our own lock
+    try:
+        locked = lock_out(out, lambda: claim_out(out, args, left))
+    except OSError as exc:
+        print(f"[yadebreak] error: --out = {out}: cannot be written ({error_line(exc)}); "
+              "nothing was run", file=sys.stderr, flush=True)
+        raise SystemExit(1) from None
+    try:
+        yield
+    finally:
+        if locked:                       # the run is over (a YADE prompt may follow)
+            _LOCKS.pop(str(Path(out).resolve())).close()
+            if [p.name for p in Path(out).iterdir()] == [LOCK]:
+                (Path(out) / LOCK).unlink()        # refused before writing: leave nothing
+                if fresh:
+                    Path(out).rmdir()
+
+
+@contextmanager
+def tool_run(out, args):
+    """A `python3 -m yadebreak` command's run in the folder `out` (own_out; a refusal is one
+    line and exit code 2), marked finished (finished.json) once the block ends without error:
+    the command run again into it is refused without --overwrite 1."""
+    try:
+        with own_out(out, args):
+            yield
+            mark_finished(out, args)
+    except ScriptError as exc:
+        if debugging():
+            raise
+        fail(str(exc))
+
+
 def claim_out(out, args, found):
     """A run about to write into `out`, which held `found` (run_left_in, read before this run
     took its lock): a new run (no --resume) over an earlier run is refused (ScriptError, one line
@@ -221,8 +248,9 @@ def claim_out(out, args, found):
     if resume or found is None:
         return
     if not overwrite:
-        raise ScriptError(f"--out = {out} holds {found}: continue it with --resume 1, start it "
-                          "over with --overwrite 1, or choose another --out")
+        ways = "continue it with --resume 1, start" if hasattr(args, "resume") else "start"
+        raise ScriptError(f"--out = {out} holds {found}: {ways} it over with --overwrite 1, or "
+                          "choose another --out")
     for name in (FINISHED, CHECKPOINT, PARTIAL):
         (Path(out) / name).unlink(missing_ok=True)
 
@@ -524,7 +552,8 @@ def mark_started(out):
 
 def mark_finished(out, args):
     """The run in `out` wrote all its outputs: <out>/finished.json keeps its arguments."""
-    (Path(out) / FINISHED).write_text(json.dumps({"arguments": resume_arguments(args)}))
+    (Path(out) / FINISHED).write_text(json.dumps({"arguments": resume_arguments(args)},
+                                                 default=str))
 
 
 def check_not_finished(out, args):

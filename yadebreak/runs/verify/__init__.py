@@ -49,9 +49,9 @@ import time
 from pathlib import Path
 
 from yadebreak.model.materials import MaterialError, load_material
-from yadebreak.tools.lifecycle import progress
+from yadebreak.tools.lifecycle import progress, tool_run
 from yadebreak.tools.options import (break_at_option, integer, jobs_option, number, numbers,
-                                     out_option, text)
+                                     out_option, overwrite_option, text)
 from . import fragmentation, probability
 from .report import write_report
 from .settings import (PAPER_MATERIALS, Runner, paper_material, plan,  # noqa: F401
@@ -97,6 +97,7 @@ PARAMS = [
            "1: the ore's)", lo=0, hi=1, lo_open=True),
     jobs_option("YADE processes sharing each run's scenes"),
     out_option("out/verify"),
+    overwrite_option(),
 ]
 
 
@@ -128,15 +129,15 @@ def verify(args):
             if getattr(args, "debug", False):
                 raise
             fail(f"--materials = {args.materials}: " + "; ".join(exc.problems))
-    out.mkdir(parents=True, exist_ok=True)
-    runner = Runner(args.jobs)
-    makers = [make for name, make in FIGURES.items() if name in wanted]
-    try:
-        runner.queue(plan(makers, args, out))     # every figure's runs, the costliest first
-        figures = [make(args, runner, out) for make in makers]
-    finally:
-        runner.close()
-    write_report(out, figures, runner, args, time.time() - began)
+    with tool_run(out, args):
+        runner = Runner(args.jobs)
+        makers = [make for name, make in FIGURES.items() if name in wanted]
+        try:
+            runner.queue(plan(makers, args, out))     # every figure's runs, the costliest first
+            figures = [make(args, runner, out) for make in makers]
+        finally:
+            runner.close()
+        write_report(out, figures, runner, args, time.time() - began)
     progress(f"wrote {out / 'report.md'} ({time.time() - began:.0f} s)")
     return 0
 

@@ -12,7 +12,9 @@ from pathlib import Path
 from yadebreak.model.intervals import Interval, elastic_wave_speed
 from yadebreak.model.materials import MaterialError, load_material
 from yadebreak.tools.lifecycle import write_atomic
-from yadebreak.tools.options import ScriptParser, fail, out_option, read_params
+from yadebreak.tools.lifecycle import tool_run
+from yadebreak.tools.options import (ScriptParser, add_params, fail, out_option, overwrite_option,
+                                     read_params)
 from yadebreak.tools.calibration import data, outputs
 from .fit import apply_bootstrap, bootstrap, fit_all
 from .mle import FitError
@@ -33,6 +35,7 @@ def parser():
                    "(0: profile likelihood; default 0)")
     p.add_argument("--seed", default="1", help="seed of the bootstrap resampling (default 1)")
     p.add_argument("--debug", default="0", help="1: tracebacks instead of one-line errors")
+    add_params(p, [overwrite_option()])
     return p
 
 
@@ -44,13 +47,14 @@ def _whole(text, option, lo):
 
 def main(argv=None):
     args = parser().parse_args(sys.argv[1:] if argv is None else argv)
-    read_params(args, [out_option(None)])
+    read_params(args, [out_option(None), overwrite_option()])
     replicates = _whole(args.bootstrap, "bootstrap", 0)
     seed = _whole(args.seed, "seed", 0)
     if not args.name.replace("_", "").replace("-", "").isalnum():
         fail(f"--name = {args.name!r}: letters, digits, '_' and '-' only (it names the file)")
     try:
-        return run(args, replicates, seed)
+        with tool_run(args.out, args):
+            return run(args, replicates, seed)
     except (data.DataError, FitError, MaterialError) as exc:
         if args.debug == "1":
             raise
