@@ -344,6 +344,8 @@ class ContactReader:
             for k, g in enumerate(self.geoms):
                 if g is None:
                     pair = (int(self.a[k]), int(self.b[k]))
+                    if bodies[pair[0]] is None or bodies[pair[1]] is None:
+                        continue                   # erased since (YADE's has() would abort)
                     inter = interactions[pair] if interactions.has(*pair) else None
                     if inter is None or not inter.isReal:
                         continue

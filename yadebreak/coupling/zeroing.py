@@ -212,8 +212,8 @@ class OverlapZeroing:
         """The overlap (m) of a wall or facet pair as YADE last computed it (None for spheres,
         whose overlap comes from their positions): O.save does not keep ScGeom.penetrationDepth,
         which apply() reads before the InteractionLoop has computed it again."""
-        if not O.interactions.has(*key):
-            return None
+        if any(O.bodies[i] is None for i in key) or not O.interactions.has(*key):
+            return None                        # (has() aborts YADE for an erased body)
         inter = O.interactions[key]
         geom = inter.geom
         if geom is None or all(isinstance(O.bodies[i].shape, wrapper.Sphere) for i in key):
