@@ -100,12 +100,11 @@ EXACT = os.environ.get("YADEBREAK_EXACT_REGRESSION") == "1"
 #: What the nudges did to the cases recorded before the replacement engine's read-mode change
 #: (4 nudged runs each; "prefix": the largest difference in (a), relative to its tolerance's scale):
 MEASURED = """
-bed_default        breakages 28-30, damage events 60-67, unbreakable stressed 11-17 (one
-                   nudge of four outside the band of the other runs: 17 against [8, 15]; the
-                   band of all five, [5, 23], holds it), steps 108,900-116,100, broken fraction
-                   unchanged
-bed_auto           prefix 1e-13; damage events 38-50, particles damaged 7-8, unbreakable
-                   stressed 7-8, steps 145,400-148,200, simulated time within 0.7 %
+bed_default        (recorded again with the "fast" schedule that follows every tracked body
+                   and the bed's in-memory reload every 5 chunks) breakages 29-30, damage
+                   events 59-64, steps 108,500-111,700, broken fraction unchanged
+bed_auto           (recorded again with the bed's reload) damage events 37-40, breakages 11,
+                   steps 83,000, broken fraction unchanged
 single_copper      prefix 1e-12; progeny sizes within 3e-9, counts unchanged
 single_ab_t10      prefix 4e-12; at 600 J/kg breakages 23-25, damage events 129-139, steps
                    3,300-3,800 (13 %: three runs at 3,800), t10 30.8-31.0 %
