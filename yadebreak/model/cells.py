@@ -244,8 +244,9 @@ class WeightSolution:
 
 
 def _hessian(faces, seeds, n):
-    """The dual's Hessian dV_i/dw_j: -A_ij / (2 |s_i - s_j|) off the diagonal, minus the row sum on
-    it (a graph Laplacian, dense: n is at most a few hundred). Face areas symmetrised."""
+    """The Jacobian dV_i/dw_j (minus the concave dual's Hessian): -A_ij / (2 |s_i - s_j|) off the
+    diagonal, minus the row sum on it (a graph Laplacian, dense: n is at most a few hundred).
+    Face areas symmetrised."""
     i, j, area = faces
     coef = area / (2.0 * np.linalg.norm(seeds[i] - seeds[j], axis=1))
     h = np.zeros((n, n))
