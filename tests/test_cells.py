@@ -209,17 +209,18 @@ def test_gaudin_schuhmann_law_passes_t10_at_one_tenth():
 def test_cells_follow_the_progeny_distribution(t10, smallest):
     """200 breakages of a unit cube (copper ore, Eq. 10), fixed seed: the mean mass passing
     1/2, 1/4, 1/10, 1/25 of the cube's side (its sieve size), cells at their own sieve size plus
-    the ledger spread below `smallest` (relative) by the law, against Eq. 10, at the sieves at
-    least 2.5 times the smallest resolved size (nearer, cells sieving just under the threshold
-    join the ledger and add to its passing). 15 % relative, 2 points absolute below 10 %.
+    the ledger spread below `smallest` (relative) by the law, against Eq. 10: 15 % relative,
+    2 points absolute below 10 %. The sieves at least 2.5 times the smallest resolved size test
+    the cells; the finer ones test mostly the ledger (cells sieving just under the threshold join
+    it and raise its passing: +11 % at 1/10 and 1/25 for t10' = 10 %).
 
-    Why that tolerance holds at 200: one breakage's passing scatters by 2-6 points (standard
-    deviation; 5 at 1/2, 1.1 at 1/4 for t10' = 10 %), so the mean of 200 is within 0.4 point of
-    its expectation; what the tolerance bounds is the bias, from the spread of a cell's sieve
-    size about the size its volume was set for (0.1-0.2 in ln b): measured +1.3 / +1.8 points at
-    1/2 / 1/4 (t10' = 10 %) and -4.5 at 1/2 (25 %), against 8.5 / 3.6 / 13.5 allowed.
-    Cost: about 6 min (10 %, ~140 cells a breakage) and 1.5 min (25 %, ~36 cells) on this
-    2-core machine.
+    Why that tolerance holds at 200: one breakage's passing scatters by 0.1-5 points (standard
+    deviation 4.9 / 1.4 / 0.2 / 0.1 at 1/2 ... 1/25 for t10' = 10 %), so the mean of 200 is
+    within 0.35 point of its expectation; what the tolerance bounds is the bias, from the spread
+    of a cell's sieve size about the size its volume was set for (0.1-0.2 in ln b). Measured
+    (this seed): t10' = 10 %: 58.17 / 26.07 / 11.15 / 5.90 against 56.92 / 24.19 / 10.00 / 5.29;
+    t10' = 25 %: 86.75 / 55.05 / 25.98 / 14.45 against 90.09 / 55.01 / 25.00 / 13.90. Cost on
+    this shared 2-core machine: 6.5 min (10 %, 143 cells a breakage), 45 s (25 %, 36 cells).
     """
     beta = load_material("copper_ore").beta_params
     rng = np.random.default_rng(43)
@@ -227,10 +228,9 @@ def test_cells_follow_the_progeny_distribution(t10, smallest):
     passing = np.mean([cells.fragment_cells(rng, CUBE, t10, beta, smallest).passing(sieves)
                        for _ in range(200)], axis=0) * 100.0
     target = model.progeny_passing(t10, beta, sieves)
-    tested = sieves >= 2.5 * smallest
-    assert tested.sum() >= 1
     allowed = np.where(target < 10.0, 2.0, 0.15 * target)
-    assert np.all(np.abs(passing - target)[tested] <= allowed[tested]), (passing, target)
+    assert np.any(sieves >= 2.5 * smallest)
+    assert np.all(np.abs(passing - target) <= allowed), (passing, target)
 
 
 def test_a_vanished_cell_is_revived():
