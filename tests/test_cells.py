@@ -76,8 +76,8 @@ def test_sphere_like_polyhedron_sieves_at_its_diameter():
 
 # --------------------------------------------------------------------------- power cells
 def _check_tessellation(parent, seeds, weights):
-    """Volumes sum to the parent's (1e-12 relative); each cell convex (its vertices are all on its
-    hull) and within the parent; sample points fall in exactly one cell (interiors disjoint)."""
+    """Volumes sum to the parent's (1e-12 relative); each cell (an intersection of half-spaces,
+    so convex) within the parent; sample points fall in exactly one cell (interiors disjoint)."""
     parent_hull = ConvexHull(parent)
     got = cells.laguerre_cells(parent, seeds, weights)
     live = [c for c in got if c is not None]
