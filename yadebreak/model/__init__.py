@@ -6,6 +6,7 @@
 equations   the Tavares UFRJ model, one function per equation (docs/model.md numbers them)
 materials   material files (TOML) read, checked and converted to SI once
 families    progeny families for sphere replacement
+cells       convex cells of a broken polyhedron (clipped Laguerre tessellation)
 placement   where fragments go inside their parent, and how they move
 bonds       bonded agglomerates: the beam-bond model and its material files
 milling     the laboratory ball mill's classical relations (critical speed, Bond, power)
