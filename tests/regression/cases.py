@@ -61,11 +61,13 @@ CASES = {
                                          "--read-period", "1", "--seed", "2"]),
     "bed_auto": ("bed_impact", ["--rings", "2", "--energy", "2.0", "--read-period", "auto",
                                 "--seed", "3", "--global-damping", "0.3"]),
-    # in one scene each (--scene-particles), as they were recorded before scenes of a few existed
+    # in one scene each (--scene-particles), as they were recorded before scenes of a few existed;
+    # in this process (--jobs 1): nudged.py nudges the scenes built here, not a pool worker's
     "single_copper": ("single_impact", ["--particles", "20", "--energies", "150,700",
-                                        "--scene-particles", "20"]),
+                                        "--scene-particles", "20", "--jobs", "1"]),
     "single_ab_t10": ("single_impact", ["--material", "ab_t10_ore", "--particles", "16",
-                                        "--energies", "250,600", "--scene-particles", "4"]),
+                                        "--energies", "250,600", "--scene-particles", "4",
+                                        "--jobs", "1"]),
     "drop_weight": ("drop_weight", ["--particles", "4", "--energies", "150,600"]),
     "repeated_copper": ("repeated_impact", ["--particles", "40", "--impacts", "6"]),
     "repeated_ab_t10": ("repeated_impact", ["--material", "ab_t10_ore", "--size", "5.5e-3",
