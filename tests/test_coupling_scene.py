@@ -147,3 +147,20 @@ def test_a_scene_saved_with_yadebreak_save_reloaded_in_the_same_process_goes_on(
     again = coupling.controller_of()
     assert again is not brk and again.events == brk.events[:len(again.events)]
     assert again.state.log.path == log
+
+
+def test_an_event_log_on_a_full_disk_stops_run_steps_without_yades_traceback(scene, capfd):
+    """A write that fails inside YADE's loop (the PyRunner) would come out with YADE's traceback
+    printed: run_steps raises the OSError itself once the step is done; the event stays in
+    memory. /dev/full: every write fails with ENOSPC."""
+    import errno
+    from yade import O
+    coupling = _scene()
+    O.bodies[1].state.vel = (0, 0, -40.0)          # 800 J/kg: it breaks at the plate
+    brk = coupling.attach({"ore": "copper_ore"}, seed=1, event_log="/dev/full")
+    with pytest.raises(OSError) as failed:
+        coupling.run_steps(20000)
+    assert failed.value.errno == errno.ENOSPC
+    assert len(brk.events) >= 1
+    out, err = capfd.readouterr()
+    assert "Traceback" not in out + err

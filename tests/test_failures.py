@@ -643,3 +643,28 @@ def test_a_command_run_again_into_its_out_is_refused_until_overwrite(tmp_path, c
     assert {p.name: p.read_bytes() for p in out.iterdir()} == kept
     assert main(["demo", "--out", str(out), "--material", "granulite", "--overwrite", "1"]) == 0
     assert (out / "model_granulite.png").is_file()
+
+
+def test_an_append_that_fails_leaves_the_file_as_it_was(tmp_path, monkeypatch):
+    """The disk fills halfway through an append (the events of a scene merged into an energy's
+    log): the file is cut back to its whole lines, and the error goes on."""
+    import errno
+    import io
+    path = tmp_path / "events.jsonl"
+    path.write_text('{"a": 1}\n')
+
+    class HalfFull(io.TextIOWrapper):
+        def write(self, text):
+            super().write(text[: len(text) // 2])
+            self.flush()
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+    def open_half_full(file, mode="r"):
+        return HalfFull(io.open(file, mode + "b"))
+    monkeypatch.setattr(lifecycle, "open", open_half_full, raising=False)
+    with pytest.raises(OSError):
+        lifecycle.append_whole(path, '{"b": 2}\n{"c": 3}\n')
+    assert path.read_text() == '{"a": 1}\n'
+    monkeypatch.undo()
+    lifecycle.append_whole(path, '{"b": 2}\n')
+    assert path.read_text() == '{"a": 1}\n{"b": 2}\n'

@@ -11,7 +11,7 @@ from .yade_api import O, current_scene, find_engine, scene_folder, wrapper
 from .config import AttachError, Config
 from .controller import Controller
 from .scene_materials import breakable_spheres, check_mapping, dummy_materials, resolve
-from .state import BREAKABLE, BodyRow, EngineState
+from .state import BREAKABLE, BodyRow, EngineState, EventLog
 from .stepping import smallest_rayleigh_time
 
 _ENGINES: dict[str, Controller] = {}
@@ -311,10 +311,18 @@ def load_checkpoint(path, label="yadebreak"):
 def run_steps(steps):
     """Advance the scene by `steps` steps now and return. O.run(n, True) waits for the run in 40 ms
     polls (measured: 40 ms for 1 to 500 steps of a small scene, 120 ms for 5000 that take 71 ms),
-    so short runs in a loop (a run to rebound, a progress loop) step directly."""
+    so short runs in a loop (a run to rebound, a progress loop) step directly. An event log that
+    cannot be written (a full disk) stops it after the step, with that OSError alone (from a
+    PyRunner it would come with YADE's traceback printed)."""
     step = O.step
-    for _ in range(int(steps)):
-        step()
+    failed = EventLog.deferred = []
+    try:
+        for _ in range(int(steps)):
+            step()
+            if failed:
+                raise failed[0]
+    finally:
+        EventLog.deferred = None
 
 
 def on_read(label):

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -185,6 +186,11 @@ class EventLog:
     """Every breakage and damage event, in memory and, when a path is given, appended to a
     JSON-lines file as it happens (flushed: a run that dies leaves its events)."""
 
+    #: while coupling.engine.run_steps steps the scene, a list: a write that fails (a full disk)
+    #: is put there for run_steps to raise after the step, outside YADE's loop (an error raised
+    #: inside a PyRunner comes out with YADE's traceback printed); the event stays in memory
+    deferred = None
+
     def __init__(self, path=None, events=()):
         self.path = None if path is None else Path(path)
         self.events = list(events)
@@ -206,11 +212,35 @@ class EventLog:
     def record(self, event):
         self.events.append(event)
         if self.path is not None:
-            if self._file is None:
-                self.path.parent.mkdir(parents=True, exist_ok=True)
-                self._file = open(self.path, "a", buffering=1)
-            self._file.write(json.dumps(event) + "\n")
-            self._file.flush()
+            whole = None
+            try:
+                if self._file is None:
+                    self.path.parent.mkdir(parents=True, exist_ok=True)
+                    self._file = open(self.path, "a", buffering=1)
+                whole = self._file.tell()
+                self._file.write(json.dumps(event) + "\n")
+                self._file.flush()
+            except OSError as exc:
+                self._cut(whole)
+                if EventLog.deferred is None:
+                    raise
+                EventLog.deferred.append(exc)
+
+    def _cut(self, size):
+        """After a failed write: the file closed and cut back to its whole lines (`size` bytes;
+        cutting needs no space on a full disk), so that it never ends in half an event."""
+        file, self._file = self._file, None
+        if file is None:
+            return
+        try:
+            file.close()                 # flushes what is buffered: fails again on a full disk
+        except OSError:
+            pass
+        if size is not None:
+            try:
+                os.truncate(self.path, size)
+            except OSError:
+                pass
 
     def close(self):
         if self._file is not None:

@@ -14,7 +14,7 @@ from yadebreak.model import placement
 from yadebreak.coupling import add_materials, attach, run_steps
 from yadebreak.coupling.rolling import rolling_engine
 from yadebreak.coupling.yade_api import O, utils, wrapper as _w
-from yadebreak.tools.lifecycle import stop_point, stop_points
+from yadebreak.tools.lifecycle import append_whole, stop_point, stop_points
 
 
 def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False, rolling=None):
@@ -161,8 +161,7 @@ def run_scenes(spec, which, event_log=None, on_scene=None):
         tally.add(brk, ids, initial_mass)
         tally.scene_wall_s += time.perf_counter() - began
         if log is not None:
-            with open(log, "a") as f:
-                f.writelines(json.dumps({"scene": k, **e}) + "\n" for e in brk.events)
+            append_whole(log, "".join(json.dumps({"scene": k, **e}) + "\n" for e in brk.events))
             brk.close()                       # the scene's log file, merged
             live.unlink(missing_ok=True)
         if on_scene is not None:

@@ -377,6 +377,20 @@ def kept_outputs(out, since):
     return text + ("" if wrote_summary else "; no summary.json was written")
 
 
+def append_whole(path, text):
+    """Append `text` to `path` whole or not at all: a write that fails (a full disk) cuts the
+    file back to its size before (cutting needs no space), then the error goes on."""
+    path = Path(path)
+    size = path.stat().st_size if path.exists() else 0
+    try:
+        with open(path, "a") as f:
+            f.write(text)
+    except OSError:
+        if path.exists():
+            os.truncate(path, size)
+        raise
+
+
 def run_wall_time(loop, start):
     """Wall time (s) of a checkpointed run over all its invocations: those before this one (up to
     their last checkpoint: the rest was simulated again), kept by --resume in
