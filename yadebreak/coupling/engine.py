@@ -239,11 +239,15 @@ def save(path):
     """O.save the scene with the state of every attached engine and rolling friction part (kept
     in O.tags, the event log named relative to the file's folder). O.save alone does not store
     it: after O.load such a scene refuses to go on rather than go on wrongly."""
-    folder = os.path.dirname(os.path.abspath(str(path)))
+    _store_all(os.path.dirname(os.path.abspath(str(path))))
+    O.save(str(path))
+
+
+def _store_all(folder=None):
+    """Every engine's and rolling friction part's state into O.tags (before O.save)."""
     for ctl in _ENGINES.values():
         _store(ctl, folder)
     rolling.store()
-    O.save(str(path))
 
 
 def reload(label="yadebreak"):
@@ -259,9 +263,7 @@ def reload(label="yadebreak"):
     56,100 differed in the last bit from step 56,597 on and ended with 81 damage events against
     88; a one-ulp nudge of one body does the same."""
     walls = {name: ctl.wall_time for name, ctl in _ENGINES.items()}
-    for ctl in _ENGINES.values():
-        _store(ctl)
-    rolling.store()
+    _store_all()
     O.saveTmp(_RELOAD)
     O.loadTmp(_RELOAD)
     forget()

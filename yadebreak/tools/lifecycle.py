@@ -143,30 +143,30 @@ def lock_out(out, claim=None):
     if out.exists() and not out.is_dir():
         raise NotADirectoryError(errno.ENOTDIR, "a file, not a folder", str(out))
     key = str(out.resolve())
-    if key in _LOCKS:                     # this process holds it already
-        if claim is not None:
-            claim()
-        return False
-    out.mkdir(parents=True, exist_ok=True)
-    f = open(out / LOCK, "a+")
-    try:
-        fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError as exc:
-        f.seek(0)
-        holder = f.read().strip()
-        f.close()
-        if exc.errno not in (errno.EAGAIN, errno.EACCES):   # a file system without locks: run
-            if claim is not None:
-                claim()
-            return False
-        raise ScriptError(f"--out = {out}: another run is writing there ({holder or 'a process'}"
-                          "); wait for it to end or choose another --out") from None
+    f = None
+    if key not in _LOCKS:                 # (else this process holds it already)
+        out.mkdir(parents=True, exist_ok=True)
+        f = open(out / LOCK, "a+")
+        try:
+            fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            f.seek(0)
+            holder = f.read().strip()
+            f.close()
+            f = None
+            if exc.errno in (errno.EAGAIN, errno.EACCES):    # else a file system without locks
+                raise ScriptError(f"--out = {out}: another run is writing there "
+                                  f"({holder or 'a process'}); wait for it to end or choose "
+                                  "another --out") from None
     try:
         if claim is not None:
             claim()
     except BaseException:
-        f.close()
+        if f is not None:
+            f.close()
         raise
+    if f is None:
+        return False
     f.seek(0)
     f.truncate()
     f.write(f"process {os.getpid()}, started {time.strftime('%Y-%m-%d %H:%M:%S')}\n")
@@ -399,13 +399,18 @@ def run_wall_time(loop, start):
 
 
 def write_atomic(path, text):
-    """Write `text` to `path` through a temporary file and os.replace: `path` holds the old
+    """Write `text` to `path` whole or not at all (write_whole)."""
+    write_whole(path, lambda tmp: tmp.write_text(text))
+
+
+def write_whole(path, write):
+    """write(tmp) to a temporary file beside `path`, then os.replace: `path` holds the old
     content or the new, never part of it (a full disk, a kill); the temporary file is removed if
     the write fails."""
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     try:
-        tmp.write_text(text)
+        write(tmp)
         os.replace(tmp, path)
     except BaseException:
         tmp.unlink(missing_ok=True)
@@ -413,16 +418,11 @@ def write_atomic(path, text):
 
 
 def save_figure(fig, path, **options):
-    """fig.savefig(path, **options) whole or not at all, as write_atomic (the format from the
+    """fig.savefig(path, **options) whole or not at all (write_whole; the format from the
     path's suffix)."""
     path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        fig.savefig(tmp, format=path.suffix.lstrip(".") or None, **options)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    write_whole(path, lambda tmp: fig.savefig(tmp, format=path.suffix.lstrip(".") or None,
+                                              **options))
 
 
 def read_checkpoint(path, load):
