@@ -12,7 +12,7 @@ OUT ?= out
 # LINK_PACKAGE.
 deps:
 	@if ! command -v yade >/dev/null 2>&1 || ! $(PY) -c "import pytest, numpy, scipy, matplotlib, \
-		dask, distributed, xdist; from yadebreak.coupling.yadepath import ensure_yade_importable as ok; \
+		dask, distributed, xdist; from yadebreak.adapter.yadepath import ensure_yade_importable as ok; \
 		assert ok()" >/dev/null 2>&1; then \
 		echo "[yadebreak] installing YADE and Python packages from Debian (a few minutes, once)"; \
 		apt-get update -q && DEBIAN_FRONTEND=noninteractive apt-get install -y -q \

@@ -15,9 +15,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
-from yadebreak import coupling, scenes  # noqa: E402
+from yadebreak import engine, scenes  # noqa: E402
 from yadebreak.scenes import poured_bed  # noqa: E402
-from yadebreak.coupling.yade_api import O  # noqa: E402
+from yadebreak.adapter.yade_api import O  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--layers", type=int, default=5)
@@ -38,7 +38,7 @@ def fastest_lower(particles, height):
 
 
 for packing in ("lattice", "poured"):
-    coupling.forget()
+    engine.forget()
     brk, info = scenes.bed_impact_scene(args.material, 5.5e-3, args.rings, args.layers, 3.05,
                                         seed=1, packing=packing)
     for st in brk.bodies.values():
@@ -46,7 +46,7 @@ for packing in ("lattice", "poured"):
     particles, ball = info["particles"], O.bodies[info["ball"]]
     while True:
         before = poured_bed.kinetic_energy(particles)
-        coupling.run_steps(20)
+        engine.run_steps(20)
         if any(O.interactions.withBody(info["ball"])):
             break
     scenes.hold_release(info)
@@ -55,7 +55,7 @@ for packing in ("lattice", "poured"):
     fastest = 0.0
     for mark in (2e-4, 1e-3):
         while O.time < touch + mark:
-            coupling.run_steps(50)
+            engine.run_steps(50)
             fastest = max(fastest, fastest_lower(particles, height))
         rows.append((f"+{1e3 * mark:g} ms", particle_contacts(particles), fastest,
                      ball.state.vel[2]))

@@ -17,7 +17,7 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 import numpy as np  # noqa: E402
 
 from yadebreak import load_material  # noqa: E402
-from yadebreak.tools.calibration import bootstrap, data, examples, fit_all, fracture  # noqa: E402
+from yadebreak.studies.calibration import bootstrap, data, examples, fit_all, fracture  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "docs" / "examples" / "calibration"
 

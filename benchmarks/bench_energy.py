@@ -12,13 +12,13 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
-from yadebreak import coupling, load_material, scenes  # noqa: E402
+from yadebreak import engine, load_material, scenes  # noqa: E402
 
 SPEEDS = (1.0, 5.0, 14.14, 20.0, 28.28, 100.0)
 
 
 def errors(read_period):
-    coupling.forget()
+    engine.forget()
     share = load_material("copper_ore").energy_partition(load_material("steel"))
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=SPEEDS, emin=0.0,
                                    read_period=read_period)

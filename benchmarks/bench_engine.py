@@ -20,11 +20,11 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
 
-from yadebreak import coupling, scenes  # noqa: E402
-from yadebreak.coupling.yade_api import O, utils, wrapper as _wrapper  # noqa: E402
+from yadebreak import engine, scenes  # noqa: E402
+from yadebreak.adapter.yade_api import O, utils, wrapper as _wrapper  # noqa: E402
 
 QUICK = "--quick" in sys.argv
-# O.run(n, True) waits in 40 ms polls, so steps are timed with coupling.run_steps (O.step in a
+# O.run(n, True) waits in 40 ms polls, so steps are timed with engine.run_steps (O.step in a
 # loop, the same for every mode); the window is the ball's loading of the bed
 STEPS = 3000 if QUICK else 8000
 REPEATS = 1 if QUICK else 3
@@ -41,7 +41,7 @@ def bed_rate(rings, layers, mode):
 
 
 def _bed_rate_once(rings, layers, mode):
-    coupling.forget()
+    engine.forget()
     options = {} if mode in ("plain", "noop") else {"read_period": 1 if mode == "exact" else mode}
     # the scenes of issue 9's figures: stacked layers, no rolling friction (bench_rolling.py
     # measures that)
@@ -56,11 +56,11 @@ def _bed_rate_once(rings, layers, mode):
             engines.insert(3, _wrapper.PyRunner(command="pass", iterPeriod=1))
         O.engines = engines
     while not any(O.interactions.withBody(info["ball"])):       # to the first touch
-        coupling.run_steps(50)
+        engine.run_steps(50)
     scenes.hold_release(info)
     read_before = brk.wall_time["read"]
     start = time.perf_counter()
-    coupling.run_steps(STEPS)
+    engine.run_steps(STEPS)
     elapsed = time.perf_counter() - start
     contacts = O.interactions.countReal()
     read_share = (brk.wall_time["read"] - read_before) / elapsed
@@ -89,18 +89,18 @@ def per_step_table():
 def cloud(n, dummies="spheres"):
     """n spheres of 5.5 mm on a loose cubic grid (no contacts), and a controller."""
     O.reset()
-    coupling.forget()
-    ip2, _ = coupling.add_materials({"ore": "copper_ore"})
+    engine.forget()
+    ip2, _ = engine.add_materials({"ore": "copper_ore"})
     side = int(np.ceil(n ** (1 / 3)))
     pitch = 6e-3
     grid = [(i * pitch, j * pitch, k * pitch) for i in range(side) for j in range(side)
             for k in range(side)][:n]
     O.bodies.append([utils.sphere(p, 2.75e-3, material="ore") for p in grid])
     O.engines = scenes.hertz_engines(ip2)
-    brk = coupling.attach({"ore": "copper_ore"}, seed=1, time_step_fraction=None,
+    brk = engine.attach({"ore": "copper_ore"}, seed=1, time_step_fraction=None,
                           dummies=dummies)
     O.dt = 1e-7
-    coupling.run_steps(3)
+    engine.run_steps(3)
     return brk, side, pitch
 
 
@@ -112,7 +112,7 @@ def event_table():
         mid = n // 2
         victims = [mid + k for k in range(0, 40, 4)]
         t_step = time.perf_counter()
-        coupling.run_steps(20)           # not O.run(20, True): its 40 ms wait would be the figure
+        engine.run_steps(20)           # not O.run(20, True): its 40 ms wait would be the figure
         normal_step = (time.perf_counter() - t_step) / 20
         own, extra, sizes = [], [], []
         for v in victims[:5]:
@@ -151,10 +151,10 @@ def end_to_end():
     every step: wall time and its shares."""
     import argparse
     import tempfile
-    from yadebreak.runs import bed
+    from yadebreak.jobs import bed
     print("\n3. The default bed impact end to end (target 3 minutes), where the time goes")
     for read, dummies in (("fast", "ledger"), (1, "spheres")):
-        coupling.forget()
+        engine.forget()
         with tempfile.TemporaryDirectory() as out:
             args = argparse.Namespace(material="copper_ore", size=5.5e-3, rings=3, layers=1,
                                       energy=3.05, speed=0.0, seed=1, time_step_fraction=0.05,

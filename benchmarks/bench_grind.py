@@ -1,4 +1,4 @@
-"""Measurement: the mechanistic mill model (yadebreak.tools.grinding) on synthetic spectra
+"""Measurement: the mechanistic mill model (yadebreak.studies.grinding) on synthetic spectra
 (docs/grinding.md, Section 7).
 
     /usr/bin/python3 benchmarks/bench_grind.py [--material copper_ore] [--minutes 10]
@@ -18,7 +18,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
-from yadebreak.tools.grinding import (BatchGrinder, feed_masses, root2_classes,  # noqa: E402
+from yadebreak.studies.grinding import (BatchGrinder, feed_masses, root2_classes,  # noqa: E402
                                 synthetic_spectra)
 from yadebreak.model.materials import load_material  # noqa: E402
 

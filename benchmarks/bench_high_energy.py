@@ -19,16 +19,16 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
 
-from yadebreak import coupling, load_material, scenes  # noqa: E402
-from yadebreak.model import reports  # noqa: E402
-from yadebreak.coupling import run_steps  # noqa: E402
-from yadebreak.coupling.yade_api import O  # noqa: E402
+from yadebreak import engine, load_material, scenes  # noqa: E402
+from yadebreak.analysis import reports  # noqa: E402
+from yadebreak.engine import run_steps  # noqa: E402
+from yadebreak.adapter.yade_api import O  # noqa: E402
 
 SIZE = 10e-3
 
 
 def scene(particles, energy, **options):
-    coupling.forget()
+    engine.forget()
     return scenes.impact_scene("copper_ore", SIZE, [np.sqrt(2 * energy)] * particles, seed=1,
                                **options)
 
@@ -57,7 +57,7 @@ def at_the_peak(particles, energy, at):
     run_steps(at)
     with_engine = per_step(100)
     bodies, contacts = len([b for b in O.bodies if b is not None]), O.interactions.countReal()
-    coupling.detach()
+    engine.detach()
     plain = per_step(20)
     print(f"at step {at}: {bodies} bodies, {contacts} interactions: yadebreak "
           f"{with_engine:.2f} ms/step, plain YADE {plain:.2f} ms/step, ratio "

@@ -16,8 +16,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
-from yadebreak import coupling, scenes  # noqa: E402
-from yadebreak.coupling.yade_api import O  # noqa: E402
+from yadebreak import engine, scenes  # noqa: E402
+from yadebreak.adapter.yade_api import O  # noqa: E402
 
 QUICK = "--quick" in sys.argv
 STEPS = 3000 if QUICK else 10000
@@ -27,7 +27,7 @@ MODES = ("none", "every 10 steps", "every step")
 
 def _rate(layers, mode):
     """(us per step, the rolling part's own us per step, real contacts at the end)."""
-    coupling.forget()
+    engine.forget()
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 3, layers, 3.05, seed=1)
     for st in brk.bodies.values():
         st.fracture_energy = 1e30
@@ -40,12 +40,12 @@ def _rate(layers, mode):
     elif mode == "every step":
         part.iterPeriod = 1
     while not any(O.interactions.withBody(info["ball"])):       # to the first touch
-        coupling.run_steps(50)
+        engine.run_steps(50)
     scenes.hold_release(info)
     O.timingEnabled = True
     own_before = 0 if part is None else part.execTime
     start = time.perf_counter()
-    coupling.run_steps(STEPS)
+    engine.run_steps(STEPS)
     elapsed = time.perf_counter() - start
     own = 0.0 if part is None else (part.execTime - own_before) * 1e-9
     O.timingEnabled = False

@@ -27,10 +27,10 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
 
-from yadebreak import coupling, scenes  # noqa: E402
-from yadebreak.coupling.yade_api import O, utils, wrapper as _w  # noqa: E402
-from yadebreak.coupling.config import Config  # noqa: E402
-from yadebreak.coupling.stepping import smallest_rayleigh_time  # noqa: E402
+from yadebreak import engine, scenes  # noqa: E402
+from yadebreak.adapter.yade_api import O, utils, wrapper as _w  # noqa: E402
+from yadebreak.options.table import Config  # noqa: E402
+from yadebreak.engine.stepping import smallest_rayleigh_time  # noqa: E402
 
 RADIUS = 2.75e-3
 #: steps run before the timing (dense: a quarter of it beyond 1e3 bodies; collisional: three
@@ -61,8 +61,8 @@ def _lattice(n, pitch, column=1):
 def build(kind, n, seed=1):
     """The scene `kind` ("dense" or "collisional") of n spheres, without yadebreak."""
     O.reset()
-    coupling.forget()
-    ip2, _ = coupling.add_materials({"ore": "copper_ore", "steel": "steel"})
+    engine.forget()
+    ip2, _ = engine.add_materials({"ore": "copper_ore", "steel": "steel"})
     rng = np.random.default_rng(seed)
     if kind == "dense":
         pitch = 2 * RADIUS * (1 - 2e-4)           # neighbours overlap by 1 um: in contact
@@ -106,12 +106,12 @@ def prepare(kind, n, mode, breakable=False, speed=None, **extra):
     brk, attach_s = None, 0.0
     if options is not None:
         t0 = time.perf_counter()
-        brk = coupling.attach({"ore": "copper_ore"}, seed=1, **options)
+        brk = engine.attach({"ore": "copper_ore"}, seed=1, **options)
         attach_s = time.perf_counter() - t0
         if not breakable:
             for st in brk.bodies.values():
                 st.fracture_energy = 1e30
-    coupling.run_steps(3 * WARM_UP if kind == "collisional" else
+    engine.run_steps(3 * WARM_UP if kind == "collisional" else
                        WARM_UP if n <= 1000 else WARM_UP // 4)
     return brk, attach_s
 
@@ -127,7 +127,7 @@ def rate(kind, n, mode, steps, breakable=False, speed=None):
     brk, attach_s = prepare(kind, n, mode, breakable, speed)
     gc.collect()
     t0 = time.perf_counter()
-    coupling.run_steps(steps)
+    engine.run_steps(steps)
     elapsed = time.perf_counter() - t0
     broken = len(brk.breakage_events) if brk is not None else 0
     return 1e6 * elapsed / steps, O.interactions.countReal(), broken, attach_s
@@ -203,31 +203,31 @@ def _mill_args(out):
 def mill(steps=3000, repeats=1):
     """The default mill once settled, run from the same saved state in each mode."""
     import tempfile
-    from yadebreak.runs import mill as mill_scene
+    from yadebreak.jobs import mill as mill_scene
     print(f"\n4. The default ball mill (scripts/ball_mill.py), from the charge settled (median of "
           f"{repeats})")
     with tempfile.TemporaryDirectory() as out:
         args = _mill_args(out)
-        coupling.forget()
+        engine.forget()
         mill_scene.mill_scene(args, mill_scene._options(args, Path(out)))
         saved = str(Path(out) / "settled.yade.gz")
-        coupling.save(saved)
+        engine.save(saved)
         runs = {mode: [] for mode in MODES}
         for _ in range(repeats):
             for mode, options in MODES.items():
-                coupling.forget()
+                engine.forget()
                 O.load(saved)
                 if options != {}:                       # plain YADE, or attached afresh
-                    coupling.detach()
+                    engine.detach()
                     if options is not None:
-                        coupling.attach({"ore": "limestone"}, seed=1, dmin=args.size / 3,
+                        engine.attach({"ore": "limestone"}, seed=1, dmin=args.size / 3,
                                         **options)
                 t0 = time.perf_counter()
-                coupling.run_steps(steps)
+                engine.run_steps(steps)
                 runs[mode].append(1e6 * (time.perf_counter() - t0) / steps)
             for k in FLOOR_PERIODS:
                 O.load(saved)
-                coupling.detach()
+                engine.detach()
                 runs.setdefault(f"floor, every {k}", []).append(_floor(steps, k))
         rates = {mode: float(np.median(v)) for mode, v in runs.items()}
         plain = rates["plain"]
@@ -261,7 +261,7 @@ def _floor(steps, period):
         # YADE's objects kept, as the engine's reader keeps them (an erased contact's are dropped)
         _ORE_CONTACTS[:] = [(i.geom, i.phys) for i in O.interactions.all(True)
                             if i.id1 in ore or i.id2 in ore]
-        coupling.run_steps(min(100, steps - done))
+        engine.run_steps(min(100, steps - done))
     return 1e6 * (time.perf_counter() - t0) / steps
 
 
@@ -278,7 +278,7 @@ def memory(n):
     gc.collect()
     plain = _rss()
     brk, _ = prepare("dense", n, "default")
-    coupling.run_steps(200)
+    engine.run_steps(200)
     gc.collect()
     own = _rss() - plain
     print(f"\n6. Memory, dense scene of {n} bodies: yadebreak adds {own / 2 ** 20:.0f} MB "

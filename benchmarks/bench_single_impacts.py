@@ -18,12 +18,12 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 import numpy as np  # noqa: E402
 
-from yadebreak import coupling, load_material, scenes  # noqa: E402
-from yadebreak.model import reports  # noqa: E402
+from yadebreak import engine, load_material, scenes  # noqa: E402
+from yadebreak.analysis import reports  # noqa: E402
 
 
 def run(material, size, energy, particles, per_scene):
-    coupling.forget()
+    engine.forget()
     start = time.perf_counter()
     tally, _ = scenes.single_impacts(material, size, np.sqrt(2 * energy), particles,
                                             per_scene or particles, 1)

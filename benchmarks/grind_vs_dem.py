@@ -45,7 +45,7 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 from yadebreak import model  # noqa: E402
 from yadebreak.model import families, milling  # noqa: E402
-from yadebreak.tools.grinding import (BatchGrinder, feed_masses, from_mill_run,  # noqa: E402
+from yadebreak.studies.grinding import (BatchGrinder, feed_masses, from_mill_run,  # noqa: E402
                                 root2_classes)
 from yadebreak.model.materials import load_material  # noqa: E402
 

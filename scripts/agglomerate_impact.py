@@ -20,11 +20,11 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.runs import job_options  # noqa: E402
+from yadebreak.jobs import options as job_options  # noqa: E402
 
 args = job_options.read("agglomerate_impact", __doc__)
 
-from yadebreak.runs import agglomerate  # noqa: E402
-from yadebreak.tools.lifecycle import run_script  # noqa: E402
+from yadebreak.jobs import agglomerate  # noqa: E402
+from yadebreak.jobs.lifecycle import run_script  # noqa: E402
 
 summary = run_script(agglomerate.run, args)

@@ -13,11 +13,11 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.runs import job_options  # noqa: E402
+from yadebreak.jobs import options as job_options  # noqa: E402
 
 args = job_options.read("extremes", __doc__)
 
-from yadebreak.runs import extremes  # noqa: E402
-from yadebreak.tools.lifecycle import run_script  # noqa: E402
+from yadebreak.jobs import extremes  # noqa: E402
+from yadebreak.jobs.lifecycle import run_script  # noqa: E402
 
 sys.exit(run_script(extremes.run, args))

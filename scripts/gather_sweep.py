@@ -3,7 +3,7 @@
     /usr/bin/python3 scripts/gather_sweep.py [--sweep out/sweep] [--out out/sweep_report]
                                              [--table scripts/bed_sweep.table]
 
-Writes configurations.csv, configurations.md and the figures (yadebreak.tools.bed_report;
+Writes configurations.csv, configurations.md and the figures (yadebreak.studies.bed_report;
 docs/outputs.md). The sweep's own sweep.csv, a row per table line, is written by `python3 -m
 yadebreak sweep` or `python3 -m yadebreak gather`.
 """
@@ -11,8 +11,8 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-from yadebreak.tools.bed_report import report  # noqa: E402
-from yadebreak.tools.options import ScriptParser, out_option, read_params  # noqa: E402
+from yadebreak.studies.bed_report import report  # noqa: E402
+from yadebreak.options.flags import ScriptParser, out_option, read_params  # noqa: E402
 
 parser = ScriptParser(description=__doc__)
 parser.add_argument("--sweep", default="out/sweep",

@@ -17,11 +17,11 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))   # yade sets argv[0]
 
-from yadebreak.runs import job_options  # noqa: E402
+from yadebreak.jobs import options as job_options  # noqa: E402
 
 args = job_options.read("single_impact", __doc__)
 
-from yadebreak.runs import impacts  # noqa: E402
-from yadebreak.tools.lifecycle import run_script  # noqa: E402
+from yadebreak.jobs import impacts  # noqa: E402
+from yadebreak.jobs.lifecycle import run_script  # noqa: E402
 
 brk = run_script(impacts.single, args)      # the last scene's controller, at the prompt without -x

@@ -1,6 +1,6 @@
 import pytest
 
-from yadebreak.coupling.yadepath import ensure_yade_importable
+from yadebreak.adapter.yadepath import ensure_yade_importable
 
 HAVE_YADE = ensure_yade_importable()
 
@@ -18,9 +18,9 @@ def pytest_collection_modifyitems(config, items):
 def scene():
     """A fresh YADE scene (one Omega per process) and a clean yadebreak registry."""
     from yade import O
-    from yadebreak import coupling
-    coupling.forget()
+    from yadebreak import engine
+    engine.forget()
     O.reset()
     yield O
-    coupling.forget()
+    engine.forget()
     O.reset()

@@ -199,7 +199,7 @@ def test_one_scene_runs_both_criteria_and_fragments_pause(scene):
     """Tavares and Ab-T10 particles side by side; fragments count no energy for pause_steps."""
     from yade import O, utils
     from yadebreak import scenes
-    from yadebreak.coupling import add_materials, attach
+    from yadebreak.engine import add_materials, attach
     ip2, _ = add_materials({"cu": "copper_ore", "ab": "ab_t10_ore", "plate": "steel"})
     O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="plate"))
     r = SIZE / 2

@@ -17,7 +17,7 @@ def _two_spheres(radius, distance, binder_changes, seed=1):
     """Two glass spheres `distance` apart along x bonded by one beam; sphere 0 fixed."""
     from yade import O, utils
     from yadebreak.model import bonds
-    from yadebreak.coupling import bonded
+    from yadebreak.engine.parts import bonds as bonded
     mat = bonds.load_agglomerate_material("glass_epoxy")
     mat = mat.with_binder(**binder_changes)
     sphere_mat = O.materials.append(__import__("yade").wrapper.FrictMat(
@@ -69,7 +69,7 @@ def test_bonded_cantilever_deflects_as_timoshenko(scene):
     moment (at the clamp) P L."""
     from yade import O
     from yadebreak.model import bonds
-    from yadebreak.coupling import bonded
+    from yadebreak.engine.parts import bonds as bonded
     length, radius = 2e-3, 0.8e-3
     mat, ids, watch = _two_spheres(radius, length, {"radius_multiplier": 0.5,
                                                     "tensile_strength": 1e5,
@@ -110,7 +110,7 @@ def test_small_agglomerate_breaks_as_the_document_reports(scene, tmp_path):
     broken bonds and the summary agree; broken bonds' spheres that touch again do so by
     Hertz-Mindlin, never by a bond."""
     from yade import O
-    from yadebreak.runs import agglomerate
+    from yadebreak.jobs import agglomerate
     from yadebreak.model import bonds
     summary = agglomerate.run(_args(tmp_path), quiet=True)
     assert summary["end_reason"] == "finished"
@@ -152,12 +152,12 @@ def test_small_agglomerate_breaks_as_the_document_reports(scene, tmp_path):
 
 
 def agglomerate_watch():
-    from yadebreak.coupling import bonded
+    from yadebreak.engine.parts import bonds as bonded
     return bonded._WATCHES[bonded.LABEL]
 
 
 def test_build_and_breakage_are_reproducible_from_the_seed(scene, tmp_path):
-    from yadebreak.runs import agglomerate
+    from yadebreak.jobs import agglomerate
     first = agglomerate.run(_args(tmp_path / "a", particles=120, duration=1e-4), quiet=True)
     second = agglomerate.run(_args(tmp_path / "b", particles=120, duration=1e-4), quiet=True)
     assert (tmp_path / "a" / "bonds_broken.csv").read_text() == (
@@ -173,9 +173,9 @@ def test_the_scalar_screen_never_misses_a_bond_near_its_strength(scene, tmp_path
     """BondWatch computes exact end moments only where a scalar upper bound reaches 80 % of a
     strength: mid-impact, the exact stresses of every intact bond give the same counts and the
     same failing bonds."""
-    from yadebreak.runs import agglomerate
+    from yadebreak.jobs import agglomerate
     from yadebreak.model import bonds
-    from yadebreak.coupling import bonded
+    from yadebreak.engine.parts import bonds as bonded
     from yade import O
     agglomerate.run(_args(tmp_path, particles=200, duration=2e-5), quiet=True)
     watch = agglomerate_watch()
@@ -214,9 +214,9 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
     times) are the uninterrupted run's to the last digit: checkpoints are written where every run
     renews its contacts as a load would (bonded.renew_contacts)."""
     from yade import O
-    from yadebreak.runs import agglomerate
-    from yadebreak.coupling import bonded
-    from yadebreak.tools.lifecycle import RunFinished, ScriptError
+    from yadebreak.jobs import agglomerate
+    from yadebreak.engine.parts import bonds as bonded
+    from yadebreak.jobs.lifecycle import RunFinished, ScriptError
     small = dict(particles=120, duration=1.5e-4)     # 89 of 431 bonds break, by 0.1 ms
     whole = agglomerate.run(_args(tmp_path / "whole", checkpoint_every=-1.0, **small), quiet=True)
     cut = tmp_path / "cut"
@@ -254,8 +254,8 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
 
 
 def test_a_damaged_checkpoint_is_refused_in_one_line(scene, tmp_path):
-    from yadebreak.runs import agglomerate
-    from yadebreak.tools.lifecycle import ScriptError
+    from yadebreak.jobs import agglomerate
+    from yadebreak.jobs.lifecycle import ScriptError
     (tmp_path / "checkpoint.yade.gz").write_bytes(b"\x1f\x8b\x08garbage")
     with pytest.raises(ScriptError, match=r"checkpoint.yade.gz is damaged .*run again without "
                                           r"--resume$"):
@@ -268,8 +268,8 @@ def test_a_time_step_that_cannot_finish_is_refused_before_the_run(scene, tmp_pat
     counter; 1e-300 a time step whose square (in the rolling stiffness) is no float: both refused
     in one line before a step is taken."""
     from yade import O
-    from yadebreak.runs import agglomerate
-    from yadebreak.coupling import AttachError
+    from yadebreak.jobs import agglomerate
+    from yadebreak.engine import AttachError
     for fraction, steps in ((1e-18, r"needs \d\.\d+e\+2\d steps "),
                             (1e-300, r"needs \d\.\d+e\+30\d steps ")):
         with pytest.raises(AttachError) as info:
@@ -288,8 +288,8 @@ def test_a_bonded_scene_loads_with_its_watch_and_a_plain_save_is_refused(scene, 
     counts, and the run goes on breaking bonds); a scene O.saved later, whose stored state is
     stale, is refused at its first step rather than run with the wrong bonds."""
     from yade import O
-    from yadebreak.runs import agglomerate
-    from yadebreak.coupling import bonded
+    from yadebreak.jobs import agglomerate
+    from yadebreak.engine.parts import bonds as bonded
     material, packing = agglomerate.build(_args(tmp_path, particles=60))
     O.reset()
     built = bonded.agglomerate_scene(material, packing, seed=3)

@@ -6,46 +6,46 @@ pytestmark = pytest.mark.yade
 
 def _scene(with_engines=True):
     from yade import O, utils
-    from yadebreak import coupling, scenes
-    ip2, _ = coupling.add_materials({"ore": "copper_ore", "steel": "steel"})
+    from yadebreak import engine, scenes
+    ip2, _ = engine.add_materials({"ore": "copper_ore", "steel": "steel"})
     O.bodies.append(utils.wall(0, axis=2, material="steel"))
     O.bodies.append(utils.sphere((0, 0, 0.003), 0.00275, material="ore"))
     if with_engines:
         O.engines = scenes.hertz_engines(ip2)
-    return coupling
+    return engine
 
 
 def test_unknown_material_label(scene):
-    coupling = _scene()
-    with pytest.raises(coupling.AttachError, match=r"unknown YADE material label\(s\) \['rock'\].*'ore'"):
-        coupling.attach({"rock": "copper_ore"})
+    engine = _scene()
+    with pytest.raises(engine.AttachError, match=r"unknown YADE material label\(s\) \['rock'\].*'ore'"):
+        engine.attach({"rock": "copper_ore"})
 
 
 def test_unknown_material_file(scene):
-    coupling = _scene()
-    with pytest.raises(coupling.AttachError, match="unknown material 'unobtainium'"):
-        coupling.attach({"ore": "unobtainium"})
+    engine = _scene()
+    with pytest.raises(engine.AttachError, match="unknown material 'unobtainium'"):
+        engine.attach({"ore": "unobtainium"})
 
 
 def test_attach_before_engines(scene):
-    coupling = _scene(with_engines=False)
-    with pytest.raises(coupling.AttachError, match="no InteractionLoop: set O.engines"):
-        coupling.attach({"ore": "copper_ore"})
+    engine = _scene(with_engines=False)
+    with pytest.raises(engine.AttachError, match="no InteractionLoop: set O.engines"):
+        engine.attach({"ore": "copper_ore"})
 
 
 def test_attach_twice(scene):
-    coupling = _scene()
-    coupling.attach({"ore": "copper_ore"})
-    with pytest.raises(coupling.AttachError, match="already attached"):
-        coupling.attach({"ore": "copper_ore"})
+    engine = _scene()
+    engine.attach({"ore": "copper_ore"})
+    with pytest.raises(engine.AttachError, match="already attached"):
+        engine.attach({"ore": "copper_ore"})
 
 
 def test_a_stiffness_scale_that_makes_a_modulus_absurd_is_refused(scene):
     """stiffness_scale multiplies the files' moduli: 1e-300 would overflow the time step midway;
     refused, one line, naming the material, its file, the value, the range and the unit."""
-    from yadebreak import coupling
-    with pytest.raises(coupling.AttachError) as info:
-        coupling.add_materials({"ore": "copper_ore", "steel": "steel"}, stiffness_scale=1e-300)
+    from yadebreak import engine
+    with pytest.raises(engine.AttachError) as info:
+        engine.add_materials({"ore": "copper_ore", "steel": "steel"}, stiffness_scale=1e-300)
     message = str(info.value)
     assert message.startswith("material 'ore' (") and "copper_ore.toml) with stiffness_scale = " \
         "1e-300: young = 5.2e-290 Pa is out of range: accepted in [100000, 1.5e+12] Pa" in message
@@ -60,35 +60,35 @@ def test_a_stiffness_scale_that_makes_a_modulus_absurd_is_refused(scene):
 def test_a_scene_material_out_of_its_physical_range_is_refused(scene, field, value, shown):
     """A partner's YADE material made by hand (not from a file) is checked as files are."""
     from yade import O, utils, wrapper
-    coupling = _scene()
+    engine = _scene()
     wall = wrapper.FrictMat(label="wall", **{field: value})
     O.materials.append(wall)
     O.bodies.append(utils.wall(0.05, axis=0, material="wall"))
-    with pytest.raises(coupling.AttachError) as info:
-        coupling.attach({"ore": "copper_ore"})
+    with pytest.raises(engine.AttachError) as info:
+        engine.attach({"ore": "copper_ore"})
     assert str(info.value) == f"YADE material 'wall': {shown}"
 
 
 def test_non_sphere_with_breakable_material(scene):
     from yade import O, utils
-    coupling = _scene()
+    engine = _scene()
     O.bodies.append(utils.box((0.1, 0, 0.01), (0.005, 0.005, 0.005), material="ore"))
-    with pytest.raises(coupling.AttachError, match="Box.*only spheres can break"):
-        coupling.attach({"ore": "copper_ore"})
+    with pytest.raises(engine.AttachError, match="Box.*only spheres can break"):
+        engine.attach({"ore": "copper_ore"})
 
 
 def test_non_breakable_material_mapped(scene):
-    coupling = _scene()
-    with pytest.raises(coupling.AttachError, match="'steel' .* is not breakable"):
-        coupling.attach({"ore": "steel"})
+    engine = _scene()
+    with pytest.raises(engine.AttachError, match="'steel' .* is not breakable"):
+        engine.attach({"ore": "steel"})
 
 
 def test_scene_without_breakable_body_warns(scene):
     from yade import O
-    coupling = _scene()
+    engine = _scene()
     O.bodies.erase(1)
     with pytest.warns(RuntimeWarning, match="no breakable body"):
-        brk = coupling.attach({"ore": "copper_ore"})
+        brk = engine.attach({"ore": "copper_ore"})
     O.run(10, True)                       # and runs, doing nothing
     assert brk.events == []
 
@@ -105,17 +105,17 @@ def test_scene_without_breakable_body_warns(scene):
     (dict(colour="red"), r"unknown option\(s\) \['colour'\]"),
 ])
 def test_bad_options(scene, option, message):
-    coupling = _scene()
-    with pytest.raises(coupling.AttachError, match=message):
-        coupling.attach({"ore": "copper_ore"}, **option)
+    engine = _scene()
+    with pytest.raises(engine.AttachError, match=message):
+        engine.attach({"ore": "copper_ore"}, **option)
 
 
 def test_time_step_too_large_warns_with_the_remedy(scene):
     from yade import O
-    coupling = _scene()
+    engine = _scene()
     O.dt = 1e-6                     # the 5.5 mm sphere's Rayleigh time is 3.5e-6 s
     with pytest.warns(RuntimeWarning, match=r"O.dt = 1e-06 s is 28 % of the Rayleigh time.*time_step_fraction"):
-        coupling.attach({"ore": "copper_ore"}, time_step_fraction=None)
+        engine.attach({"ore": "copper_ore"}, time_step_fraction=None)
     assert O.dt == 1e-6             # the user's time step is left alone
 
 
@@ -158,7 +158,7 @@ def test_a_bad_event_log_is_refused_before_the_scene_changes(scene, tmp_path, ev
     import os
     import subprocess
     from yade import O
-    coupling = _scene()
+    engine = _scene()
     before = _unchanged(O)
     ro = tmp_path / "ro"
     ro.mkdir()
@@ -168,8 +168,8 @@ def test_a_bad_event_log_is_refused_before_the_scene_changes(scene, tmp_path, ev
     if "ro" in event_log and not mounted and os.access(ro, os.W_OK):
         pytest.skip("no read-only folder can be made here")
     try:
-        with pytest.raises(coupling.AttachError, match=shown):
-            coupling.attach({"ore": "copper_ore"}, event_log=event_log.format(tmp=tmp_path))
+        with pytest.raises(engine.AttachError, match=shown):
+            engine.attach({"ore": "copper_ore"}, event_log=event_log.format(tmp=tmp_path))
     finally:
         if mounted:
             subprocess.run(["umount", str(ro)], check=True)
@@ -177,19 +177,19 @@ def test_a_bad_event_log_is_refused_before_the_scene_changes(scene, tmp_path, ev
 
 
 def test_an_event_log_in_a_missing_folder_makes_the_folder(scene, tmp_path):
-    coupling = _scene()
+    engine = _scene()
     path = tmp_path / "a" / "b" / "events.jsonl"
-    coupling.attach({"ore": "copper_ore"}, event_log=str(path))
+    engine.attach({"ore": "copper_ore"}, event_log=str(path))
     assert path.is_file()
 
 
 def test_materials_not_a_mapping_is_refused_before_the_scene_changes(scene):
     from yade import O
-    coupling = _scene()
+    engine = _scene()
     before = _unchanged(O)
-    with pytest.raises(coupling.AttachError, match=r"materials = \['copper_ore'\]: accepted a "
+    with pytest.raises(engine.AttachError, match=r"materials = \['copper_ore'\]: accepted a "
                                                    r"dict \{YADE material label"):
-        coupling.attach(["copper_ore"])
+        engine.attach(["copper_ore"])
     assert _unchanged(O) == before
 
 
@@ -197,10 +197,10 @@ def test_a_second_label_over_bodies_another_tracks_is_refused(scene):
     """Two engines over the same bodies would judge each twice (one broke body 1 while the other
     recorded a damage event on it)."""
     from yade import O
-    coupling = _scene()
-    coupling.attach({"ore": "copper_ore"}, label="first")
+    engine = _scene()
+    engine.attach({"ore": "copper_ore"}, label="first")
     before = _unchanged(O)
-    with pytest.raises(coupling.AttachError, match=r"bodies \[1\] are tracked by the yadebreak "
+    with pytest.raises(engine.AttachError, match=r"bodies \[1\] are tracked by the yadebreak "
                                                    r"engine 'first' already"):
-        coupling.attach({"ore": "copper_ore"}, label="second")
+        engine.attach({"ore": "copper_ore"}, label="second")
     assert _unchanged(O) == before

@@ -19,7 +19,7 @@ def _args(out, energy, seed=3, rings=1):
 
 
 def test_small_bed_writes_every_output_and_conserves_mass(scene, tmp_path):
-    from yadebreak.runs import bed
+    from yadebreak.jobs import bed
     brk, summary = bed.run(_args(tmp_path, 0.6), quiet=True)
     for name in ("summary.json", "events.jsonl", "size_distribution.csv", "size_distribution.png",
                  "bed_top_view.png", "paraview/spheres.pvd", "paraview/surfaces.pvd"):
@@ -36,12 +36,12 @@ def test_small_bed_writes_every_output_and_conserves_mass(scene, tmp_path):
 
 
 def test_higher_energy_breaks_more_mass(scene, tmp_path):
-    from yadebreak.runs import bed
-    from yadebreak import coupling
+    from yadebreak.jobs import bed
+    from yadebreak import engine
     from yade import O
     masses = []
     for energy in (0.3, 0.9):
-        coupling.forget()
+        engine.forget()
         O.reset()
         _, summary = bed.run(_args(tmp_path / f"e{energy}", energy, seed=5), quiet=True)
         masses.append(summary["broken_mass"])
@@ -62,15 +62,15 @@ def test_bed_script_runs_headless(tmp_path):
 
 def test_resume_continues_exactly_like_an_uninterrupted_run(scene, tmp_path):
     """A run that dies after a checkpoint and goes on with --resume gives the same results."""
-    from yadebreak.runs import bed
-    from yadebreak import coupling
+    from yadebreak.jobs import bed
+    from yadebreak import engine
     from yade import O
     whole = _args(tmp_path / "whole", 0.9, seed=5)
     whole.checkpoint_every = -1                    # never
     _, reference = bed.run(whole, quiet=True)
     reference_events = (tmp_path / "whole" / "events.jsonl").read_text()
 
-    coupling.forget()
+    engine.forget()
     O.reset()
     died = _args(tmp_path / "died", 0.9, seed=5)
     died.checkpoint_every = 0.0                    # after every chunk
@@ -78,7 +78,7 @@ def test_resume_continues_exactly_like_an_uninterrupted_run(scene, tmp_path):
     brk, summary = bed.run(died, quiet=True)
     assert summary is None and (tmp_path / "died" / "checkpoint.yade.gz").exists()
     assert 0 < len(brk.breakage_events) < reference["breakage_events"]
-    coupling.forget()
+    engine.forget()
     O.reset()
     died.stop_after, died.resume = 0.0, True
     _, resumed = bed.run(died, quiet=True)

@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 
 from yadebreak import model
-from yadebreak.tools.calibration import (ab_t10, bootstrap, damage, data, examples, fit_all, fracture,
+from yadebreak.studies.calibration import (ab_t10, bootstrap, damage, data, examples, fit_all, fracture,
                                    progeny, t10)
 from yadebreak.model.materials import load_material
-from yadebreak.tools.calibration.mle import FitError
+from yadebreak.studies.calibration.mle import FitError
 
 REPO = Path(__file__).resolve().parent.parent
 TAVARES = ("copper_ore", "granulite", "limestone_2", "iron_ore_1")
@@ -252,7 +252,7 @@ def test_cli_bad_data_exit_2_one_line_no_material(tmp_path):
 
 def _fit_here(capsys, *args):
     """`python3 -m yadebreak fit` in this process: its exit code and its stderr's lines."""
-    from yadebreak.__main__ import main
+    from yadebreak.cli import main
     with pytest.raises(SystemExit) as end:
         main(["fit", *map(str, args)])
     return end.value.code, capsys.readouterr().err.strip().splitlines()

@@ -86,7 +86,7 @@ def test_the_module_names_of_version_0_2_still_import():
     import yadebreak
     from yadebreak import families, materials, placement, scriptargs, sweep
     from yadebreak.model import families as new_families
-    assert families is new_families and yadebreak.bed.__name__ == "yadebreak.runs.bed"
+    assert families is new_families and yadebreak.bed.__name__ == "yadebreak.jobs.bed"
     assert materials.load_material("copper_ore").name == "copper_ore"
     assert callable(placement.spin_scale) and callable(scriptargs.script_params)
     assert callable(sweep.read_table)

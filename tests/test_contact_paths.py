@@ -30,15 +30,15 @@ def _rows(reader):
 @pytest.mark.parametrize("cs", [0.0, 0.5])
 def test_both_paths_read_a_breaking_bed_alike(scene, cs):
     from yade import utils
-    from yadebreak import coupling, scenes
-    from yadebreak.coupling.contacts import ContactReader
+    from yadebreak import engine, scenes
+    from yadebreak.engine.contacts import ContactReader
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 3, 1, 6.0, seed=4, read_period=1,
                                         dummies="spheres", cs=cs)
     O = scene
     each, full = (ContactReader(brk.reader.stiffness, cs, brk.reader.emin) for _ in range(2))
     each.small, full.small = 10 ** 9, -1
     while not any(O.interactions.withBody(info["ball"])):
-        coupling.run_steps(50)
+        engine.run_steps(50)
     scenes.hold_release(info)
     reads = 0
     seen = {"zeroed": 0, "asleep": 0, "inherited": 0}
@@ -67,24 +67,24 @@ def test_many_contacts_saved_and_loaded_read_on_as_the_run_that_went_on(scene, t
     """A scene read by the numpy path (a bed of many particles pressed by a heavy ball), saved
     with yadebreak.save mid-impact and loaded: its rows find YADE's objects again and the run
     goes on to the same contacts, numbers and events as the run that was never interrupted."""
-    from yadebreak import coupling, scenes
+    from yadebreak import engine, scenes
     O = scene
 
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 4, 3, 6.0, seed=3,
                                         packing="lattice", read_period="every_step")
     while not any(O.interactions.withBody(info["ball"])):
-        coupling.run_steps(50)
+        engine.run_steps(50)
     scenes.hold_release(info)
-    coupling.run_steps(300)
+    engine.run_steps(300)
     assert len(brk.reader) > brk.reader.small          # the numpy path reads this scene
-    coupling.save(tmp_path / "mid.yade.gz")
-    coupling.run_steps(400)
+    engine.save(tmp_path / "mid.yade.gz")
+    engine.run_steps(400)
     went_on = (_rows(brk.reader), [dict(e) for e in brk.events])
     O.reset()
-    coupling.forget()
+    engine.forget()
     O.load(str(tmp_path / "mid.yade.gz"))
-    coupling.run_steps(400)
-    brk = coupling.controller_of()
+    engine.run_steps(400)
+    brk = engine.controller_of()
     rows, events = _rows(brk.reader), [dict(e) for e in brk.events]
     # YADE's save and load keep the scene to round-off (the regression cases' 1e-9)
     assert rows.keys() == went_on[0].keys()

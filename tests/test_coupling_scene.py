@@ -16,14 +16,14 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def _scene(**options):
     from yade import O, utils
-    from yadebreak import coupling, scenes
-    ip2, _ = coupling.add_materials({"ore": "copper_ore", "steel": "steel"})
+    from yadebreak import engine, scenes
+    ip2, _ = engine.add_materials({"ore": "copper_ore", "steel": "steel"})
     O.bodies.append(utils.wall(0, axis=2, material="steel"))
     b = utils.sphere((0, 0, 0.0029), 0.00275, material="ore")
     b.state.vel = (0, 0, -5.0)
     O.bodies.append(b)
     O.engines = scenes.hertz_engines(ip2)
-    return coupling
+    return engine
 
 
 def test_stepping_from_a_function_leaves_the_users_globals_alone(tmp_path):
@@ -33,12 +33,12 @@ def test_stepping_from_a_function_leaves_the_users_globals_alone(tmp_path):
         import sys
         sys.path.insert(0, {str(ROOT)!r})
         from yade import O, utils
-        from yadebreak import coupling, scenes
-        ip2, _ = coupling.add_materials({{"ore": "copper_ore", "steel": "steel"}})
+        from yadebreak import engine, scenes
+        ip2, _ = engine.add_materials({{"ore": "copper_ore", "steel": "steel"}})
         O.bodies.append(utils.wall(0, axis=2, material="steel"))
         O.bodies.append(utils.sphere((0, 0, 0.003), 0.00275, material="ore"))
         O.engines = scenes.hertz_engines(ip2)
-        coupling.attach({{"ore": "copper_ore"}})
+        engine.attach({{"ore": "copper_ore"}})
         steps = 7
         step = "mine"
         def advance(n):
@@ -46,7 +46,7 @@ def test_stepping_from_a_function_leaves_the_users_globals_alone(tmp_path):
             for _ in range(n):
                 O.step()
         advance(20)
-        coupling.run_steps(50)
+        engine.run_steps(50)
         print("GLOBALS", steps, step)
         """))
     proc = subprocess.run(["yade", "-n", "-x", str(script)], capture_output=True, text=True,
@@ -60,42 +60,42 @@ def test_a_smaller_time_step_set_before_attach_is_kept_a_larger_one_lowered(scen
     from yadebreak import load_material
     cu = load_material("copper_ore")
     tr = float(placement.rayleigh_time(0.00275, cu.density, cu.young_modulus, cu.poisson_ratio))
-    coupling = _scene()
+    engine = _scene()
     O.dt = 0.02 * tr
-    coupling.attach({"ore": "copper_ore"})
+    engine.attach({"ore": "copper_ore"})
     assert O.dt == pytest.approx(0.02 * tr, rel=1e-12)
-    coupling.forget()
+    engine.forget()
     O.reset()
-    coupling = _scene()
+    engine = _scene()
     O.dt = 0.5 * tr
-    coupling.attach({"ore": "copper_ore"})
+    engine.attach({"ore": "copper_ore"})
     assert O.dt == pytest.approx(0.05 * tr, rel=1e-12)
 
 
 def test_a_scene_saved_with_o_save_alone_refuses_to_go_on(scene, tmp_path):
     from yade import O
-    from yadebreak.coupling import AttachError
-    coupling = _scene()
-    coupling.attach({"ore": "copper_ore"})
-    coupling.run_steps(30)
+    from yadebreak.engine import AttachError
+    engine = _scene()
+    engine.attach({"ore": "copper_ore"})
+    engine.run_steps(30)
     O.save(str(tmp_path / "plain.yade.gz"))          # yadebreak's state stays the attach's
-    coupling.forget()
+    engine.forget()
     O.load(str(tmp_path / "plain.yade.gz"))
     with pytest.raises(AttachError, match=r"save scenes with yadebreak.save\(path\)"):
-        coupling.controller_of()
+        engine.controller_of()
 
 
 def test_detach_removes_the_engine_and_keeps_the_results(scene):
     from yade import O
-    coupling = _scene()
-    brk = coupling.attach({"ore": "copper_ore"}, seed=2)
-    coupling.run_steps(400)
+    engine = _scene()
+    brk = engine.attach({"ore": "copper_ore"}, seed=2)
+    engine.run_steps(400)
     events = list(brk.events)
     assert events                                     # the impact was recorded
-    assert coupling.detach() is brk
+    assert engine.detach() is brk
     assert not [e for e in O.engines if "yadebreak" in getattr(e, "label", "")]
-    coupling.run_steps(50)
-    assert brk.events == events and coupling.attach({"ore": "copper_ore"}) is not brk
+    engine.run_steps(50)
+    assert brk.events == events and engine.attach({"ore": "copper_ore"}) is not brk
 
 
 def test_materials_are_found_from_any_folder_and_a_working_folder_overrides(tmp_path):
@@ -116,16 +116,16 @@ def test_a_scene_saved_with_o_save_alone_refuses_to_go_on_in_the_same_process(sc
     """As in a fresh process: O.save, running on, then O.reset() and O.load() in this process
     (the controller in memory is the later one's) refuses too."""
     from yade import O
-    from yadebreak.coupling import AttachError
-    coupling = _scene()
-    coupling.attach({"ore": "copper_ore"})
-    coupling.run_steps(30)
+    from yadebreak.engine import AttachError
+    engine = _scene()
+    engine.attach({"ore": "copper_ore"})
+    engine.run_steps(30)
     O.save(str(tmp_path / "plain.yade.gz"))
-    coupling.run_steps(5)
+    engine.run_steps(5)
     O.reset()
     O.load(str(tmp_path / "plain.yade.gz"))
     with pytest.raises(AttachError, match=r"save scenes with yadebreak.save\(path\)"):
-        coupling.controller_of()
+        engine.controller_of()
 
 
 def test_a_scene_saved_with_yadebreak_save_reloaded_in_the_same_process_goes_on(scene, tmp_path):
@@ -133,18 +133,18 @@ def test_a_scene_saved_with_yadebreak_save_reloaded_in_the_same_process_goes_on(
     stored state names its event log relative to the saved file's folder."""
     import json
     from yade import O
-    coupling = _scene()
+    engine = _scene()
     log = tmp_path / "run" / "events.jsonl"
-    brk = coupling.attach({"ore": "copper_ore"}, event_log=str(log))
-    coupling.run_steps(30)
-    coupling.save(tmp_path / "run" / "scene.yade.gz")
+    brk = engine.attach({"ore": "copper_ore"}, event_log=str(log))
+    engine.run_steps(30)
+    engine.save(tmp_path / "run" / "scene.yade.gz")
     stored = json.loads(O.tags["yadebreak:yadebreak"])
     assert stored["event_log"] == {"path": "events.jsonl", "relative_to": "scene file"}
     assert str(tmp_path) not in O.tags["yadebreak:yadebreak"]
-    coupling.run_steps(5)
+    engine.run_steps(5)
     O.reset()
     O.load(str(tmp_path / "run" / "scene.yade.gz"))
-    again = coupling.controller_of()
+    again = engine.controller_of()
     assert again is not brk and again.events == brk.events[:len(again.events)]
     assert again.state.log.path == log
 
@@ -155,11 +155,11 @@ def test_an_event_log_on_a_full_disk_stops_run_steps_without_yades_traceback(sce
     memory. /dev/full: every write fails with ENOSPC."""
     import errno
     from yade import O
-    coupling = _scene()
+    engine = _scene()
     O.bodies[1].state.vel = (0, 0, -40.0)          # 800 J/kg: it breaks at the plate
-    brk = coupling.attach({"ore": "copper_ore"}, seed=1, event_log="/dev/full")
+    brk = engine.attach({"ore": "copper_ore"}, seed=1, event_log="/dev/full")
     with pytest.raises(OSError) as failed:
-        coupling.run_steps(20000)
+        engine.run_steps(20000)
     assert failed.value.errno == errno.ENOSPC
     assert len(brk.events) >= 1
     out, err = capfd.readouterr()
@@ -172,25 +172,25 @@ def test_a_restored_contact_whose_partner_was_erased_since_is_dropped(scene, tmp
     when the pair's smaller id is an erased body; the bed's in-memory reload every 5 chunks
     restores rows often)."""
     from yade import O, utils
-    from yadebreak import coupling, scenes
-    ip2, _ = coupling.add_materials({"ore": "copper_ore", "steel": "steel"})
+    from yadebreak import engine, scenes
+    ip2, _ = engine.add_materials({"ore": "copper_ore", "steel": "steel"})
     O.bodies.append(utils.wall(0, axis=2, material="steel"))
     steel = utils.sphere((0, 0, 0.0029 + 0.0055 - 1e-6), 0.00275, material="steel")
     steel.state.vel = (0, 0, -10.0)            # pressing on the ore sphere from above
     O.bodies.append(steel)                     # body 1: the pair (1, 2)'s smaller id
     O.bodies.append(utils.sphere((0, 0, 0.0029), 0.00275, material="ore"))
     O.engines = scenes.hertz_engines(ip2)
-    brk = coupling.attach({"ore": "copper_ore"}, seed=1)
-    coupling.run_steps(40)
+    brk = engine.attach({"ore": "copper_ore"}, seed=1)
+    engine.run_steps(40)
     assert (1, 2) in zip(brk.reader.a.tolist(), brk.reader.b.tolist())
-    coupling.save(tmp_path / "scene.yade.gz")
+    engine.save(tmp_path / "scene.yade.gz")
     saved_at = O.iter
     O.reset()
     O.load(str(tmp_path / "scene.yade.gz"))
     O.bodies.erase(1)
-    restored = coupling.controller_of()
+    restored = engine.controller_of()
     restored.reader.small = 0                 # the path that looks the restored rows up
-    coupling.run_steps(10)
+    engine.run_steps(10)
     assert O.iter == saved_at + 10
     assert all(1 not in pair for pair in zip(restored.reader.a.tolist(),
                                              restored.reader.b.tolist()))

@@ -35,15 +35,15 @@ def test_wall_impact_receives_e_m_v2_over_2(scene, tmp_path, target_restitution)
 
 def test_two_equal_spheres_receive_half_each(scene):
     from yade import O, utils
-    from yadebreak import coupling, scenes
-    ip2, _ = coupling.add_materials({"ore": "copper_ore"})
+    from yadebreak import engine, scenes
+    ip2, _ = engine.add_materials({"ore": "copper_ore"})
     r, v = 2.75e-3, 3.0
     a = O.bodies.append(utils.sphere((0, 0, 0), r, material="ore"))
     b = O.bodies.append(utils.sphere((2 * r * 1.01, 0, 0), r, material="ore"))
     O.bodies[a].state.vel = (v, 0, 0)
     O.bodies[b].state.vel = (-v, 0, 0)
     O.engines = scenes.hertz_engines(ip2)
-    brk = coupling.attach({"ore": "copper_ore"}, seed=1, emin=0.0, read_period="every_step")
+    brk = engine.attach({"ore": "copper_ore"}, seed=1, emin=0.0, read_period="every_step")
     _unbreakable(brk, [a, b])
     O.run(3000, True)
     m = O.bodies[a].state.mass
@@ -70,19 +70,19 @@ def test_subcritical_impact_weakens_by_eqs_5_6(scene):
 
 def _events_for(seed, steps_before=None, tmp_path=None, material="limestone", read_period=1):
     from yade import O
-    from yadebreak import coupling, scenes
+    from yadebreak import engine, scenes
     speeds = list(np.linspace(3, 30, 24))
     brk, ids = scenes.impact_scene(material, 5.5e-3, speeds=speeds, seed=seed, replace=False,
                                    read_period=read_period)
     if steps_before is not None:
         O.run(steps_before, True)
         path = str(tmp_path / "mid.yade.gz")
-        coupling.save(path)                # O.save with yadebreak's state
+        engine.save(path)                # O.save with yadebreak's state
         O.run(137, True)                   # wander on, then come back to the saved state
-        coupling.forget()                  # as in a new process
+        engine.forget()                  # as in a new process
         O.load(path)
     O.run(1500 - (steps_before or 0), True)
-    brk = coupling.controller_of()
+    brk = engine.controller_of()
     return [(e["kind"], e["id"], e["iter"], round(e["specific_energy"], 9),
              round(e["fracture_energy"], 9)) for e in brk.events]
 

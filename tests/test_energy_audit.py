@@ -16,8 +16,8 @@ SPEED = 45.0
 
 
 def _mechanical_energy(brk):
-    from yadebreak.coupling.yade_api import O
-    from yadebreak.coupling.replacement import _elastic_energy
+    from yadebreak.adapter.yade_api import O
+    from yadebreak.engine.replacement import _elastic_energy
     kinetic = sum(0.5 * b.state.mass * b.state.vel.squaredNorm()
                   + 0.5 * b.state.inertia[0] * b.state.angVel.squaredNorm()
                   for b in O.bodies if b is not None and b.dynamic)
@@ -30,13 +30,13 @@ def _run(duration, every=10, **options):
     """Two particles at SPEED on a steel wall: the largest rise of the scene's mechanical energy
     between checks and its largest value (both relative to the start), the largest fragment
     speed at the end (m/s), the events."""
-    from yadebreak import coupling, scenes
-    from yadebreak.coupling.yade_api import O
+    from yadebreak import engine, scenes
+    from yadebreak.adapter.yade_api import O
     brk, _ = scenes.impact_scene("copper_ore", 10e-3, speeds=[SPEED] * 2, seed=5, **options)
     start = previous = top = _mechanical_energy(brk)
     rise = 0.0
     while O.time < duration:
-        coupling.run_steps(every)
+        engine.run_steps(every)
         now = _mechanical_energy(brk)
         rise = max(rise, (now - previous) / start)
         previous, top = now, max(top, now)
@@ -92,21 +92,21 @@ def test_a_pair_that_closes_while_asleep_wakes_without_stored_energy(scene):
     """A zeroed pair that opens sleeps (zeroing_tolerance); if it is pushed back together while
     asleep, no force resisted the closing, so it must wake with no elastic energy: its zero is
     raised to the overlap it has then (the energy would otherwise come from nowhere)."""
-    from yadebreak import coupling, scenes
-    from yadebreak.coupling.yade_api import O
+    from yadebreak import engine, scenes
+    from yadebreak.adapter.yade_api import O
     brk, (a,) = scenes.impact_scene("copper_ore", 5e-3, speeds=[0.0], zeroing_tolerance=0.5)
     brk.bodies[a].fracture_energy = 1e12       # the pair's contact, not breakage, is tested
     b = O.bodies.append(_sphere_like(O.bodies[a], offset=4.5e-3))     # 0.5 mm overlap
     brk.zeroing.zero_pair(a, b, 0.5e-3, created=False)
     brk.zeroing.wake()
     O.bodies[a].state.vel, O.bodies[b].state.vel = (0, 0, 0.5), (0, 0, 1.5)    # opening
-    coupling.run_steps(3)
+    engine.run_steps(3)
     key = (min(a, b), max(a, b))
     assert key in brk.zeroing.asleep
     for body, v in ((a, 2.0), (b, 0.0)):                               # closing hard
         O.bodies[body].state.vel = (0, 0, v)
     while key in brk.zeroing.asleep:
-        coupling.run_steps(1)
+        engine.run_steps(1)
     inter = O.interactions[a, b]
     zero = brk.zeroing.pairs[key]
     assert inter.geom.penetrationDepth > 0.5e-3 - 1e-12   # it did close past where it slept
@@ -115,7 +115,7 @@ def test_a_pair_that_closes_while_asleep_wakes_without_stored_energy(scene):
 
 
 def _sphere_like(body, offset):
-    from yadebreak.coupling.yade_api import utils
+    from yadebreak.adapter.yade_api import utils
     pos = body.state.pos
     return utils.sphere((pos[0], pos[1], pos[2] + offset), body.shape.radius,
                         material=body.material)

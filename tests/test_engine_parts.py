@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 
 from yadebreak import load_material, model
-from yadebreak.coupling import config, criteria, judging
-from yadebreak.coupling.contacts import ContactReader, Loading
-from yadebreak.coupling.state import (BREAKABLE, DUMMY, FORMAT_VERSION, UNBREAKABLE, BodyTable,
+from yadebreak.engine import judging
+from yadebreak.options import table as config
+from yadebreak.criteria import engine_side as criteria
+from yadebreak.engine.contacts import ContactReader, Loading
+from yadebreak.engine.state import (BREAKABLE, DUMMY, FORMAT_VERSION, UNBREAKABLE, BodyTable,
                                       EngineState, FinesLedger, check_format)
 
 
@@ -166,7 +168,7 @@ def _work(law, d0, f0, delta, force, first_touch=0.8):
 
 
 def test_hertz_normal_work_is_two_fifths_k_d_to_the_five_halves():
-    from yadebreak.coupling.contacts import HertzMindlinWork as law
+    from yadebreak.engine.contacts import HertzMindlinWork as law
     overlaps = np.linspace(0.0, 4e-6, 41)[1:]
     force = KNO * overlaps ** 1.5
     # from first touch in one read (the elastic force has no dashpot part)...
@@ -180,7 +182,7 @@ def test_hertz_normal_work_is_two_fifths_k_d_to_the_five_halves():
 
 
 def test_a_constant_dashpot_force_adds_its_force_times_the_displacement():
-    from yadebreak.coupling.contacts import HertzMindlinWork as law
+    from yadebreak.engine.contacts import HertzMindlinWork as law
     d0, d1, dashpot = 1e-6, 3e-6, 0.7
     work = _work(law, d0, KNO * d0 ** 1.5 + dashpot, d1, KNO * d1 ** 1.5 + dashpot)
     assert work == pytest.approx(0.4 * KNO * (d1 ** 2.5 - d0 ** 2.5) + dashpot * (d1 - d0),
@@ -194,7 +196,7 @@ def test_a_constant_dashpot_force_adds_its_force_times_the_displacement():
 
 
 def test_a_contact_that_peaked_between_reads_counts_its_work_to_the_parabola_top():
-    from yadebreak.coupling.contacts import HertzMindlinWork as law
+    from yadebreak.engine.contacts import HertzMindlinWork as law
     peak, t_peak, a = 5e-6, 2.4e-6, 1e6         # m, s, m/s^2: overlap = peak - a (t - t_peak)^2
     times = np.array([1e-6, 2e-6, 3e-6])        # reads at t0 < t1 < t2, the top between t1, t2
     x0, x1, x2 = peak - a * (times - t_peak) ** 2
@@ -209,7 +211,7 @@ def test_a_contact_that_peaked_between_reads_counts_its_work_to_the_parabola_top
 
 
 def test_a_body_counts_its_share_of_a_contacts_work_since_its_offset_from_emin_on():
-    from yadebreak.coupling.contacts import own_share, total_work
+    from yadebreak.engine.contacts import own_share, total_work
     assert total_work(2.0, 4.0, 0.5) == 4.0 and total_work(2.0, 4.0, 0.0) == 2.0
     assert own_share(3.0, 1.0, 0.25, 1e-4) == (True, 0.5)
     assert own_share(3.0, 3.0 - 5e-5, 0.25, 1e-4)[0] is False
@@ -272,7 +274,7 @@ def test_docs_options_is_the_table_as_rendered_now():
     import contextlib
     import io
     from pathlib import Path
-    from yadebreak.__main__ import main
+    from yadebreak.cli import main
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
         main(["options"])
@@ -337,7 +339,7 @@ def test_could_break_asks_for_the_fracture_energy_left_after_what_the_event_coun
     an unbreakable fragment until its first would-be breakage, a dummy or a body yadebreak does
     not know never; Ab-T10 accumulates, so any energy could be the last."""
     from yadebreak import scenes
-    from yadebreak.coupling.state import DUMMY, UNBREAKABLE
+    from yadebreak.engine.state import DUMMY, UNBREAKABLE
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=[5.0, 5.0, 5.0, 5.0], seed=2)
     c = brk.bodies.columns
     energy = c["fracture_energy"][ids].copy()

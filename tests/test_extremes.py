@@ -10,16 +10,16 @@ SLOW = {"size 200 mm at 10 m/s", "Emax/E50 = 1.001", "sigma = 0.01", "sigma = 3"
 
 
 def _names():
-    from yadebreak.coupling.yadepath import ensure_yade_importable
+    from yadebreak.adapter.yadepath import ensure_yade_importable
     if not ensure_yade_importable():
         return []
-    from yadebreak.runs import extremes
+    from yadebreak.jobs import extremes
     return [c.name for c in extremes.cases() if c.name not in SLOW]
 
 
 @pytest.mark.parametrize("name", _names())
 def test_extreme_case_is_finite_conservative_and_ends(scene, name):
-    from yadebreak.runs import extremes
+    from yadebreak.jobs import extremes
     (case,) = [c for c in extremes.cases() if c.name == name]
     r = extremes.run_case(case, fast=True)
     assert r["finite"], r

@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from yadebreak.model import reports
-from yadebreak.tools import lifecycle
-from yadebreak.tools.lifecycle import partial_outputs_on_failure, time_left
-from yadebreak.tools import options
+from yadebreak.analysis import reports
+from yadebreak.jobs import lifecycle
+from yadebreak.jobs.lifecycle import partial_outputs_on_failure, time_left
+from yadebreak.options import flags as options
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -71,8 +71,8 @@ def test_run_script_turns_a_failure_into_an_exit_code_and_a_line(capsys, excepti
 
 
 def test_a_warning_is_shown_once_naming_the_scripts_own_option(capsys):
-    from yadebreak.coupling.controller import YadebreakWarning
-    from yadebreak.coupling.stepping import ReadSchedule
+    from yadebreak.engine.controller import YadebreakWarning
+    from yadebreak.engine.stepping import ReadSchedule
     schedule = ReadSchedule.__new__(ReadSchedule)
     schedule.period, schedule.mode = 7, "fast"
     remedies = schedule.remedies()
@@ -107,8 +107,8 @@ def _bed_args(out, **changes):
 @pytest.mark.yade
 def test_a_bed_run_that_fails_midway_leaves_its_outputs_and_says_why(scene, tmp_path,
                                                                       monkeypatch):
-    from yadebreak.runs import bed
-    from yadebreak import coupling
+    from yadebreak.jobs import bed
+    from yadebreak import engine as coupling
     real, calls = coupling.run_steps, []
 
     def failing(n):                     # a batch of steps fails after the first checkpoint
@@ -131,7 +131,7 @@ def test_a_bed_run_that_fails_midway_leaves_its_outputs_and_says_why(scene, tmp_
 
 @pytest.mark.yade
 def test_a_bed_run_stopped_by_max_time_says_so(scene, tmp_path):
-    from yadebreak.runs import bed
+    from yadebreak.jobs import bed
     _, summary = bed.run(_bed_args(tmp_path, max_time=2e-4), quiet=True)
     assert summary["end_reason"] == "time_limit"
     assert "--max-time 0.0002 s" in summary["end_message"]
@@ -172,7 +172,7 @@ def test_a_small_bed_says_why_it_took_longer(scene, tmp_path, capsys):
     """One ring under 1.5 J (7 particles) breaks finer than the default bed: the run reports the
     energy per kg of bed at the start, and at the end the fall of the time step and the finest
     fragment that caused it, from its own summary."""
-    from yadebreak.runs import bed
+    from yadebreak.jobs import bed
     _, summary = bed.run(_bed_args(tmp_path, energy=1.5), quiet=False)
     said = capsys.readouterr().out
     per_kg = summary["energy"] / summary["initial_mass"]
@@ -240,7 +240,7 @@ def test_a_second_run_into_an_out_in_use_is_refused_and_a_killed_one_leaves_no_l
                                                                                     capsys):
     holder = subprocess.Popen(
         ["nice", "-n", "5", sys.executable, "-c", "import sys, time; sys.path.insert(0, "
-         "sys.argv[1]); from yadebreak.tools.lifecycle import lock_out; lock_out(sys.argv[2]); "
+         "sys.argv[1]); from yadebreak.jobs.lifecycle import lock_out; lock_out(sys.argv[2]); "
          "print('locked', flush=True); time.sleep(120)", str(ROOT), str(tmp_path)],
         stdout=subprocess.PIPE, text=True)
     try:
@@ -307,7 +307,7 @@ def test_ctrl_c_inside_a_pyrunner_ends_as_interrupted_not_as_a_pyrunner_error(sc
     """The signal strikes while YADE runs a PyRunner's Python: the step goes on to its end, and the
     run stops after it as interrupted (exit 130), not as YADE's PyRunner error."""
     from yade import wrapper
-    from yadebreak import coupling
+    from yadebreak import engine as coupling
     scene.engines = [wrapper.ForceResetter(), wrapper.PyRunner(       # the signal, then more
         command="import os, signal; os.kill(os.getpid(), signal.SIGINT); from yade import O; "
                 "O.tags['ran'] = str(int(O.tags['ran']) + 1)", iterPeriod=1, initRun=True)]
@@ -358,7 +358,7 @@ def _partial_results(tmp_path, **changes):
     args.resume = True
 
     def validate(key, result):
-        from yadebreak.model import reports
+        from yadebreak.analysis import reports
         reports.check_breakage_result(result, mat, 5.5e-3, float(key), steel, args.particles)
     return args, validate
 
@@ -407,8 +407,8 @@ def test_a_sound_partial_file_resumes(tmp_path):
 @pytest.mark.parametrize("damage", ["truncated", "empty", "garbage"])
 def test_a_damaged_checkpoint_is_refused_in_one_line_claiming_nothing(scene, tmp_path, capsys,
                                                                       damage):
-    from yadebreak.runs import bed, mill
-    from yadebreak import coupling
+    from yadebreak.jobs import bed, mill
+    from yadebreak import engine as coupling
     assert bed.run(_bed_args(tmp_path, checkpoint_every=0.0, stop_after=1e-4), quiet=True)[1] \
         is None
     path = tmp_path / "checkpoint.yade.gz"
@@ -457,9 +457,9 @@ def test_a_full_disk_stops_the_run_in_one_line_keeping_the_last_checkpoint(scene
     """Checkpoints at every chunk of steps; the third one finds the disk full: the run stops with
     one line naming what it wrote, summary.json says why, and the second checkpoint, whole, goes
     on with --resume 1 to the end of the run."""
-    from yadebreak.runs import bed
-    from yadebreak import coupling
-    from yadebreak.coupling import engine
+    from yadebreak.jobs import bed
+    from yadebreak import engine as coupling
+    from yadebreak.engine import scene as engine
     full, calls = _full_disk(after=2)
     monkeypatch.setattr(engine, "save", full(engine.save))
     with pytest.raises(SystemExit) as ended:
@@ -485,7 +485,7 @@ def test_a_full_disk_stops_the_run_in_one_line_keeping_the_last_checkpoint(scene
 def test_a_disk_full_of_frames_and_summaries_says_nothing_was_summarised(scene, tmp_path, capsys,
                                                                         monkeypatch):
     """No frame and no summary can be written: the line says so and names only what exists."""
-    from yadebreak.runs import bed, paraview
+    from yadebreak.jobs import bed, paraview
     full, calls = _full_disk(after=1)                   # the first frame, then nothing
     monkeypatch.setattr(paraview, "write_atomic", full(paraview.write_atomic))
     monkeypatch.setattr(bed, "write_atomic", full(bed.write_atomic))
@@ -559,7 +559,7 @@ def test_a_signalled_bed_run_ends_interrupted_with_a_checkpoint(scene, tmp_path,
     assert "Traceback" not in err
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["end_reason"] == "interrupted" and summary["end_message"] == f"stopped by {name}"
-    from yadebreak import coupling
+    from yadebreak import engine as coupling
     _, state = lifecycle.read_checkpoint(tmp_path / "checkpoint.yade.gz",
                                           coupling.load_checkpoint)   # whole, where it stopped
     assert scene.time == pytest.approx(summary["simulated_time"], rel=1e-12)
@@ -594,7 +594,7 @@ def test_a_failed_impact_worker_stops_the_run_with_its_last_words(tmp_path):
     (["--out", ""], "--out = '': must be a non-empty text"),
 ])
 def test_verify_refuses_bad_input_in_one_line(tmp_path, capsys, arguments, line):
-    from yadebreak.__main__ import main
+    from yadebreak.cli import main
     out = tmp_path / "v"
     with pytest.raises(SystemExit) as end:
         main(["verify", "--out", str(out), *arguments])
@@ -608,7 +608,7 @@ def test_a_read_only_out_ends_a_command_in_one_line(tmp_path, capsys, monkeypatc
     """mkdir of --out refused (a read-only file system; chmod does not stop root): one line, exit
     code 1, for the commands that write a folder."""
     import errno
-    from yadebreak.__main__ import main
+    from yadebreak.cli import main
 
     def read_only(self, *args, **kwargs):
         raise OSError(errno.EROFS, "Read-only file system", str(self))
@@ -628,7 +628,7 @@ def test_a_read_only_out_ends_a_command_in_one_line(tmp_path, capsys, monkeypatc
 def test_a_command_run_again_into_its_out_is_refused_until_overwrite(tmp_path, capsys):
     """The commands that write a run folder (demo here; grind, fit and verify alike) keep a
     finished run: run again into it, one line and exit code 2, its files untouched."""
-    from yadebreak.__main__ import main
+    from yadebreak.cli import main
     out = tmp_path / "demo"
     assert main(["demo", "--out", str(out)]) == 0
     assert (out / "finished.json").is_file()

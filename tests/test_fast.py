@@ -32,7 +32,7 @@ def test_hertz_loading_time_matches_a_measured_impact(scene):
     """The overlap of a 20 m/s impact on steel peaks at the predicted loading time (steel's
     compliance lengthens it a little: within 15 %)."""
     from yade import O
-    from yadebreak import coupling, scenes
+    from yadebreak import engine, scenes
     cu = load_material("copper_ore")
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [20.0], gap_fraction=0.0)
     brk.bodies[ids[0]].fracture_energy = 1e12
@@ -51,7 +51,7 @@ def test_hertz_loading_time_matches_a_measured_impact(scene):
 
 @pytest.mark.yade
 def test_fast_wall_impacts_receive_e_m_v2_over_2_within_3_percent(scene):
-    from yadebreak import coupling, scenes
+    from yadebreak import engine, scenes
     speeds = [1.0, 5.0, 20.0, 100.0]
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=speeds, emin=0.0,
                                    read_period="fast")
@@ -59,7 +59,7 @@ def test_fast_wall_impacts_receive_e_m_v2_over_2_within_3_percent(scene):
         brk.bodies[i].fracture_energy = 1e12
     periods = set()
     for _ in range(400):
-        coupling.run_steps(5)
+        engine.run_steps(5)
         periods.add(brk.period)
     e = load_material("copper_ore").energy_partition(load_material("steel"))
     got = {ev["id"]: ev["specific_energy"] for ev in brk.events if ev["kind"] == "damage"}
@@ -71,13 +71,13 @@ def test_fast_wall_impacts_receive_e_m_v2_over_2_within_3_percent(scene):
 def test_fast_reads_less_often_where_a_fresh_contact_cannot_bring_much_energy(scene):
     """At 1 m/s a fresh contact brings a 5.5 mm copper ore particle 2 % of its own fracture
     energy only after several steps (hertz_onset_time): "fast" waits that long."""
-    from yadebreak import coupling, scenes
-    from yadebreak.coupling.yade_api import O
+    from yadebreak import engine, scenes
+    from yadebreak.adapter.yade_api import O
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=[1.0], read_period="fast")
     cu = load_material("copper_ore")
     onset = placement.hertz_onset_time(2.75e-3, cu.density, cu.young_modulus, cu.poisson_ratio,
                                        2.0, 0.02 * brk.bodies[ids[0]].fracture_energy)
-    coupling.run_steps(20)
+    engine.run_steps(20)
     assert brk.period == min(int(0.25 * placement.hertz_loading_time(
         2.75e-3, cu.density, cu.young_modulus, cu.poisson_ratio, 2.0) / O.dt),
         int(onset / O.dt))
@@ -108,8 +108,8 @@ def _unbreakable_impact(read_period):
     fracture energy, here 300 J/kg, sets the t10' it keeps) fired at 40 m/s on steel: its
     unbreakable_stressed events and the warnings of the run."""
     import warnings
-    from yadebreak import coupling, scenes
-    coupling.forget()
+    from yadebreak import engine, scenes
+    engine.forget()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [40.0], seed=3,
@@ -189,10 +189,10 @@ def test_hertz_onset_time_against_an_integrated_hertz_impact():
                                               ("ab_t10_ore", 400.0)])
 def test_fast_single_impacts_break_as_every_step_reading(scene, material, energy):
     """Broken fraction within 3 points of every-step reading (the issue's 3 %), same particles."""
-    from yadebreak import coupling, scenes
+    from yadebreak import engine, scenes
     got = {}
     for mode in (1, "fast"):
-        coupling.forget()
+        engine.forget()
         brk, ids = scenes.impact_scene(material, 5.5e-3, [math.sqrt(2 * energy)] * 250,
                                        seed=3, replace=False, read_period=mode)
         scenes.run_until_rebound(ids)

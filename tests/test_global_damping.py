@@ -4,7 +4,7 @@ so the impact that stresses the parent is untouched, and it only takes kinetic e
 import pytest
 
 from yadebreak import load_material
-from yadebreak.coupling import config
+from yadebreak.options import table as config
 from yadebreak.model.materials import MaterialError
 
 
@@ -57,19 +57,19 @@ def test_damping_zero_is_the_undamped_run_of_a_file_without_the_field(scene, tmp
     """global_damping=0 and a copper ore file without the field (today's file) give the same
     events and leave YADE's damping off: the run is exactly what it was before the field."""
     from yade import O
-    from yadebreak import coupling
+    from yadebreak import engine
     path = tmp_path / "ore.toml"
     path.write_text(_copper_text().replace("global_damping = 0.3", ""))
     assert load_material(str(path)).global_damping == 0.0
     runs = []
     for material, options in ((str(path), {}), ("copper_ore", {"global_damping": 0.0})):
-        coupling.forget()
+        engine.forget()
         brk, ids, newton, _ = _run(material, 70.0, **options)
         assert newton.damping == 0.0
         assert len(brk.breakage_events) >= 1
         runs.append([(e["kind"], e["id"], e["iter"], e.get("specific_energy"))
                      for e in brk.events])
-        coupling.forget()
+        engine.forget()
         O.reset()
     assert runs[0] == runs[1]
 
@@ -81,10 +81,10 @@ def test_damping_leaves_the_parents_impact_and_only_takes_energy_from_fragments(
     work of the damping (YADE's nonviscDamp) is never negative nor decreasing, and positive once
     fragments move; the fragments, not the target, carry isDamped."""
     from yade import O
-    from yadebreak import coupling
+    from yadebreak import engine
     first = {}
     for gd in (0.0, None):                    # None: the file's 0.3
-        coupling.forget()
+        engine.forget()
         brk, ids, newton, work = _run("copper_ore", 70.0, global_damping=gd)
         first[gd] = next(e for e in brk.events if e["id"] == ids[0])
         if gd is None:
@@ -97,7 +97,7 @@ def test_damping_leaves_the_parents_impact_and_only_takes_energy_from_fragments(
             assert work[-1] > 0.0
         else:
             assert newton.damping == 0.0 and max(work) == 0.0
-        coupling.forget()
+        engine.forget()
         O.reset()
     assert first[0.0]["kind"] == first[None]["kind"] == "breakage"
     for key in ("iter", "specific_energy", "t10", "fracture_energy"):

@@ -1,4 +1,4 @@
-"""The mechanistic mill model (yadebreak.tools.grinding): population balance against closed forms,
+"""The mechanistic mill model (yadebreak.studies.grinding): population balance against closed forms,
 the capture model, the spectra file and its converter, and the known behaviours of batch ball
 milling on small cases (docs/grinding.md). No YADE needed; every case runs in about a second."""
 import csv
@@ -12,12 +12,12 @@ import numpy as np
 import pytest
 from scipy.linalg import expm
 
-from yadebreak.tools.grinding import (BatchGrinder, GrindingError, SpectraError, feed_masses,
+from yadebreak.studies.grinding import (BatchGrinder, GrindingError, SpectraError, feed_masses,
                                 from_mill_run, read_spectra, reid_batch, root2_classes,
                                 synthetic_spectra, write_spectra)
-from yadebreak.tools.grinding.capture import PACKING_MONOLAYER
-from yadebreak.tools.grinding.classes import FeedError
-from yadebreak.tools.grinding.cli import parse_feed
+from yadebreak.studies.grinding.capture import PACKING_MONOLAYER
+from yadebreak.studies.grinding.classes import FeedError
+from yadebreak.studies.grinding.cli import parse_feed
 from yadebreak.model.materials import load_material
 from yadebreak import model
 
@@ -429,7 +429,7 @@ def test_grind_on_a_full_disk_ends_in_one_line_and_leaves_whole_files(tmp_path, 
     one line naming the two files kept, each whole, and no temporary file."""
     import errno
     import os
-    from yadebreak.__main__ import main
+    from yadebreak.cli import main
     real, calls = os.replace, []
 
     def replace(src, dst):

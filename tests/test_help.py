@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from yadebreak import __main__ as cli
-from yadebreak.runs import job_options
+from yadebreak import cli as cli
+from yadebreak.jobs import options as job_options
 
 ROOT = Path(__file__).resolve().parent.parent
 PYTHON = "/usr/bin/python3"

@@ -40,7 +40,7 @@ def test_t10_standard_error_is_the_ratio_estimators_over_the_scenes():
     scatter between scenes: sqrt(n / (n - 1) sum (p_i - t m_i)^2) / sum m_i. Two equal scenes
     at 2 % and 4 % of 1 kg: t10 3 %, error sqrt(2 (0.01^2 + 0.01^2)) / 2 = 1 %; merged tallies
     keep every scene; one scene gives no error."""
-    from yadebreak.model.reports import ImpactTally
+    from yadebreak.analysis.reports import ImpactTally
     a, b = ImpactTally(0.029), ImpactTally(0.029)
     a.scene_t10.append([1.0, 0.02])
     assert a.t10_standard_error is None
@@ -58,12 +58,12 @@ def test_fragments_go_on_breaking_after_the_originals_broke(scene):
     follows the fragments, later generations break, and the progeny is finer than the same
     impact stopped once the originals had broken (what the runs did before): the same seed, so
     the same primary events."""
-    from yadebreak import coupling, scenes
-    from yadebreak.model import reports
+    from yadebreak import engine, scenes
+    from yadebreak.analysis import reports
     cu, steel = load_material("copper_ore"), load_material("steel")
     t10 = {}
     for follow in (False, True):
-        coupling.forget()
+        engine.forget()
         brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [np.sqrt(2 * 1500.0)] * 4, seed=2,
                                        dummies="ledger")
         scenes.run_until_rebound(ids, brk=brk if follow else None)
@@ -79,7 +79,7 @@ def test_fragments_go_on_breaking_after_the_originals_broke(scene):
 
 @pytest.mark.yade
 def test_an_energy_where_nothing_breaks_says_why_it_has_no_t10(scene):
-    from yadebreak.model import reports
+    from yadebreak.analysis import reports
     from yadebreak import scenes
     cu, steel = load_material("copper_ore"), load_material("steel")
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [np.sqrt(2 * 5.0)] * 3, seed=1)
@@ -98,7 +98,7 @@ def test_a_fragment_counts_no_work_for_the_overlap_it_inherits(scene):
     one step's loading, where counting from first touch gave 0.5 F delta over the whole overlap
     (as if each fragment had just been loaded through it: a cascade of re-breakage)."""
     from yadebreak import scenes
-    from yadebreak.coupling import run_steps
+    from yadebreak.engine import run_steps
     brk, ids = scenes.impact_scene("copper_ore", 10e-3, [0.0], seed=1, local_damping=0.5)
     brk.break_body(ids[0], ratio=20.0)
     run_steps(1)
@@ -116,14 +116,14 @@ def test_opening_slack_pairs_sleep_and_a_returning_pair_pushes_within_the_tolera
     step; sent back towards each other, it pushes again no later than 5 % of its overlap beyond
     where it turned (the reference a visit every step would have)."""
     from yade import O, utils
-    from yadebreak import coupling, scenes
-    from yadebreak.coupling import run_steps
-    ip2, _ = coupling.add_materials({"ore": "copper_ore"})
+    from yadebreak import engine, scenes
+    from yadebreak.engine import run_steps
+    ip2, _ = engine.add_materials({"ore": "copper_ore"})
     r = 1e-3
     a = O.bodies.append(utils.sphere((0, 0, 0), r, material="ore"))
     b = O.bodies.append(utils.sphere((1.6 * r, 0, 0), r, material="ore"))
     O.engines = scenes.hertz_engines(ip2)
-    brk = coupling.attach({"ore": "copper_ore"}, zeroing_tolerance=0.05, dummies="ledger")
+    brk = engine.attach({"ore": "copper_ore"}, zeroing_tolerance=0.05, dummies="ledger")
     for i in (a, b):
         brk.bodies[i].fracture_energy = 1e9
     brk.zeroing.zero_pair(a, b, 0.4 * r, created=False)       # created now, as after a breakage
@@ -152,14 +152,14 @@ def test_one_scene_is_the_run_it_always_was(scene, tmp_path):
     """single_impacts with every particle in one scene gives what impact_scene, run_until_rebound
     and breakage_result gave (the same seed: the same run), event for event."""
     from yade import O
-    from yadebreak import coupling, scenes
-    from yadebreak.model import reports
+    from yadebreak import engine, scenes
+    from yadebreak.analysis import reports
     cu, steel, speed = load_material("copper_ore"), load_material("steel"), np.sqrt(2 * 700.0)
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [speed] * 6, seed=4)
     scenes.run_until_rebound(ids, brk=brk)
     before = reports.breakage_result(brk, ids, cu, 5.5e-3, 700.0, steel)
     events = [dict(e) for e in brk.events]
-    coupling.forget()
+    engine.forget()
     O.reset()
     tally, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, 6, 6, 4,
                                      event_log=str(tmp_path / "events.jsonl"))
@@ -194,7 +194,7 @@ def test_breakage_probability_does_not_depend_on_the_scene_size(scene):
     scene and in scenes of one, the broken fractions are two samples of the same binomial; they
     differ by less than 3 sigma of a difference, sqrt(2 P (1 - P) / 60) = 0.09 at P = 0.5, and
     each lies within 3 sigma of the model."""
-    from yadebreak.model import reports
+    from yadebreak.analysis import reports
     from yadebreak import scenes
     cu, steel, speed, n = load_material("copper_ore"), load_material("steel"), np.sqrt(1000.0), 60
     p_model = float(cu.breakage_probability(500.0, 5.5e-3, partner=steel))
@@ -214,7 +214,7 @@ def test_scenes_shared_among_processes_give_the_same_run(scene, tmp_path):
     """Five scenes of one copper ore particle at 700 J/kg, run here and by two YADE processes
     taking scenes from a queue: the same events in the same order (each scene has its seed), and
     the same result to the last digit (the scenes' tallies are merged in scene order)."""
-    from yadebreak.model import reports
+    from yadebreak.analysis import reports
     from yadebreak import scenes
     cu, steel, speed = load_material("copper_ore"), load_material("steel"), np.sqrt(2 * 700.0)
     results, logs = [], []

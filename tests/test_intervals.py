@@ -22,8 +22,8 @@ def test_interval_contains_finite_numbers_within_its_ends_and_says_so(interval, 
 
 
 def test_script_options_and_attach_options_check_alike():
-    from yadebreak.coupling.config import _number
-    from yadebreak.tools.options import number
+    from yadebreak.options.table import _number
+    from yadebreak.options.flags import number
     param = number("x", 0.5, "-", "a share", lo=0, hi=1, lo_open=True)
     check = _number(0, 1, lo_open=True)
     for v in (0.0, 1e-9, 0.5, 1.0, 1.5, math.nan, math.inf):

@@ -1,11 +1,18 @@
-"""The layers the tree shows (docs/architecture.md) are the layers the imports keep:
+"""The rooms of docs/architecture.md are the rooms the imports keep. Each room may import the rooms
+named in ALLOWED (and itself); a study may reach the engine, scenes and jobs only inside a function
+(verify runs scenes; sweeps and trade-offs run scripts in other processes):
 
-    model/    imports nothing of yadebreak outside model/ (and never yade)
-    tools/    imports model/ and tools/ at module level; YADE only through a function that runs
-              inside a yade-batch row (tools/options.py) or in separate processes
-    coupling/ imports model/ and coupling/; yade only in coupling/yade_api.py
-    scenes/   model/, tools/, coupling/, scenes/
-    runs/     anything below it
+    model/     the breakage model in numpy/scipy            nothing of yadebreak outside it
+    criteria/  one class per criterion                      model
+    options/   the option table, the flags of scripts       model, criteria
+    analysis/  results against the model, plots             model, criteria
+    adapter/   the one module that imports yade             nothing
+    engine/    the engine and its parts in YADE's loop      model, criteria, options, analysis, adapter
+    scenes/    every builder of a YADE scene                 ... and engine
+    jobs/      the jobs behind scripts/, their lifecycle    ... and scenes, never adapter
+    studies/   verify, calibration, grinding, sweeps        model, criteria, options, analysis, jobs
+    coupling/  saved scenes' entry points, forwarding       engine
+    cli.py     python3 -m yadebreak                         all but adapter
 """
 import ast
 import subprocess
@@ -14,10 +21,23 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parent.parent / "yadebreak"
-LAYERS = ["model", "tools", "coupling", "scenes", "runs"]
-ALLOWED = {"model": {"model"}, "tools": {"model", "tools"}, "coupling": {"model", "coupling"},
-           "scenes": {"model", "tools", "coupling", "scenes"},
-           "runs": {"model", "tools", "coupling", "scenes", "runs"}}
+PURE = {"model", "criteria", "options", "analysis"}
+ALLOWED = {
+    "model": {"model"},
+    "criteria": {"model", "criteria"},
+    "options": {"model", "criteria", "options"},
+    "analysis": {"model", "criteria", "analysis"},
+    "adapter": {"adapter"},
+    "engine": PURE | {"adapter", "engine"},
+    "scenes": PURE | {"adapter", "engine", "scenes"},
+    "jobs": PURE | {"engine", "scenes", "jobs"},
+    "studies": PURE | {"jobs", "studies"},
+    "coupling": {"engine", "coupling"},
+    "cli": PURE | {"engine", "scenes", "jobs", "studies", "cli"},
+}
+#: what a study may import inside a function (it runs scenes in its own process or others)
+LATE = {"studies": {"engine", "scenes"}}
+ROOMS = sorted(ALLOWED)
 
 
 def _imports(path):
@@ -36,43 +56,59 @@ def _imports(path):
                 parts = package.split(".")
                 base = ".".join(parts[:len(parts) - node.level + 1] + ([base] if base else []))
             names = [f"{base}.{a.name}" for a in node.names] if base in (
-                "yadebreak", *(f"yadebreak.{layer}" for layer in LAYERS)) else [base]
+                "yadebreak", *(f"yadebreak.{room}" for room in ROOMS)) else [base]
             for name in names:
                 yield name, id(node) in top
 
 
-def _layer_of(module):
+def _room_of(module):
     parts = module.split(".")
-    return parts[1] if len(parts) > 1 and parts[0] == "yadebreak" and parts[1] in LAYERS else None
+    return parts[1] if len(parts) > 1 and parts[0] == "yadebreak" and parts[1] in ROOMS else None
 
 
-@pytest.mark.parametrize("layer", LAYERS)
-def test_each_layer_imports_only_the_layers_below_it(layer):
+def _files(room):
+    single = PACKAGE / f"{room}.py"
+    return [single] if single.exists() else sorted((PACKAGE / room).rglob("*.py"))
+
+
+@pytest.mark.parametrize("room", ROOMS)
+def test_each_room_imports_only_the_rooms_it_may(room):
     wrong = []
-    for path in sorted((PACKAGE / layer).rglob("*.py")):
+    for path in _files(room):
         for module, top_level in _imports(path):
-            other = _layer_of(module)
-            if other and other not in ALLOWED[layer] and (top_level or layer != "tools"):
-                wrong.append(f"{path.relative_to(PACKAGE)} imports {module}")
-            if layer == "model" and other not in (None, "model"):
+            other = _room_of(module)
+            allowed = ALLOWED[room] | (set() if top_level else LATE.get(room, set()))
+            if other and other not in allowed:
                 wrong.append(f"{path.relative_to(PACKAGE)} imports {module}")
     assert not wrong, "\n".join(wrong)
 
 
-def test_only_yade_api_imports_yade():
+def test_every_module_lies_in_a_room():
+    loose = [p.name for p in PACKAGE.glob("*.py")
+             if p.stem not in ROOMS and p.name not in ("__init__.py", "__main__.py", "_moved.py")]
+    folders = [p.name for p in PACKAGE.iterdir() if (p / "__init__.py").exists()
+               and p.name not in ROOMS]
+    assert not loose and not folders, (loose, folders)
+
+
+def test_only_the_adapter_imports_yade():
     found = [f"{path.relative_to(PACKAGE)} imports {module}"
              for path in sorted(PACKAGE.rglob("*.py"))
              for module, _ in _imports(path)
              if (module == "yade" or module.startswith("yade."))
-             and path != PACKAGE / "coupling" / "yade_api.py"]
+             and path != PACKAGE / "adapter" / "yade_api.py"]
     assert not found, "\n".join(found)
 
 
-def test_the_pure_layers_load_without_yade():
-    """Every module of model/ and tools/ imported in a fresh /usr/bin/python3 leaves yade out of
-    sys.modules (a user's laptop without YADE can fit data and grind)."""
+def test_the_pure_rooms_load_without_yade():
+    """Every module of the pure rooms, the studies, the jobs' lifecycle and options, and the
+    command line, imported in a fresh /usr/bin/python3, leaves yade out of sys.modules (a user's
+    laptop without YADE can fit data and grind)."""
+    paths = [p for room in sorted(PURE | {"studies"}) for p in _files(room)]
+    paths += [PACKAGE / "jobs" / "lifecycle.py", PACKAGE / "jobs" / "options.py",
+              PACKAGE / "cli.py"]
     modules = [".".join(p.relative_to(PACKAGE.parent).with_suffix("").parts).removesuffix(".__init__")
-               for layer in ("model", "tools") for p in sorted((PACKAGE / layer).rglob("*.py"))]
+               for p in paths]
     code = ("import importlib, sys\n"
             f"for m in {modules!r}: importlib.import_module(m)\n"
             "print(sorted(m for m in sys.modules if m == 'yade' or m.startswith('yade.')))")
@@ -80,3 +116,16 @@ def test_the_pure_layers_load_without_yade():
                           timeout=120, cwd=PACKAGE.parent)
     assert proc.returncode == 0, proc.stderr[-1500:]
     assert proc.stdout.strip().splitlines()[-1] == "[]"
+
+
+def _sizes():
+    for path in sorted(PACKAGE.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, (ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
+                yield path, node, node.end_lineno - node.lineno + 1
+
+
+def test_no_class_over_300_lines_and_no_function_over_80():
+    big = [f"{path.relative_to(PACKAGE)}: {node.name} has {n} lines" for path, node, n in _sizes()
+           if n > (300 if isinstance(node, ast.ClassDef) else 80)]
+    assert not big, "\n".join(big)

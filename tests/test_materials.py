@@ -186,7 +186,7 @@ def test_sampling_uses_the_generator(tmp_path):
 def test_the_criterion_is_chosen_once_by_the_material_and_the_coupling_follows_it():
     """The material's file names its criterion (Material.criterion, from one registry); YADE's
     side of each criterion is picked by the same name."""
-    from yadebreak.coupling import criteria
+    from yadebreak.criteria import engine_side as criteria
     from yadebreak.model.materials import CRITERIA
     assert set(CRITERIA) == set(criteria._CRITERIA)
     for name in available_materials():

@@ -24,7 +24,7 @@ def _args(out, **changes):
 
 def test_a_short_mill_run_keeps_mass_stays_finite_and_the_motor_does_work(scene, tmp_path):
     from yade import O
-    from yadebreak.runs import mill
+    from yadebreak.jobs import mill
     from yadebreak.model import milling
     brk, summary = mill.run(_args(tmp_path), quiet=True)
     assert summary["end_reason"] == "finished"
@@ -59,7 +59,7 @@ def test_a_short_mill_run_keeps_mass_stays_finite_and_the_motor_does_work(scene,
 
 def test_the_charge_fills_the_drum_as_asked(scene, tmp_path):
     """Fillings are bulk volumes over the drum's volume, the bulk PACKING solid."""
-    from yadebreak.runs import mill
+    from yadebreak.jobs import mill
     args = _args(tmp_path)
     balls, ores = mill.charge_counts(args)
     volume = math.pi * 0.06 ** 2 * 0.04
@@ -75,14 +75,14 @@ def test_a_resumed_mill_goes_on_from_its_checkpoint_and_refuses_other_arguments(
     the last digit (measured: the first event after the cut differs at 1e-16), and a granular flow
     amplifies that. Resumed with another speed: refused, naming it."""
     from yade import O
-    from yadebreak import coupling
-    from yadebreak.runs import mill
-    from yadebreak.tools.lifecycle import ScriptError
+    from yadebreak import engine
+    from yadebreak.jobs import mill
+    from yadebreak.jobs.lifecycle import ScriptError
     _, whole = mill.run(_args(tmp_path / "whole", duration=0.04, checkpoint_every=0.0),
                         quiet=True)
     whole_events = [json.loads(x) for x in
                     (tmp_path / "whole" / "events.jsonl").read_text().splitlines()]
-    coupling.forget()
+    engine.forget()
     O.reset()
     cut = _args(tmp_path / "cut", duration=0.04, checkpoint_every=0.0, stop_after=0.02)
     began = time.time()
@@ -90,12 +90,12 @@ def test_a_resumed_mill_goes_on_from_its_checkpoint_and_refuses_other_arguments(
     first = time.time() - began                  # (its last checkpoint: at its very end)
     before_cut = [json.loads(x) for x in
                   (tmp_path / "cut" / "events.jsonl").read_text().splitlines()]
-    coupling.forget()
+    engine.forget()
     O.reset()
     with pytest.raises(ScriptError, match=r"other values of \['speed'\]"):
         mill.run(_args(tmp_path / "cut", duration=0.04, checkpoint_every=0.0, resume=True,
                        speed=0.7), quiet=True)
-    coupling.forget()
+    engine.forget()
     O.reset()
     began = time.time()
     _, resumed = mill.run(_args(tmp_path / "cut", duration=0.04, checkpoint_every=0.0,
@@ -120,8 +120,8 @@ def test_the_spectra_run_breaks_nothing_and_feeds_the_grinding_model(scene, tmp_
     import subprocess
     import sys
     from yade import O
-    from yadebreak.runs import mill
-    from yadebreak.tools.grinding.spectra import read_spectra
+    from yadebreak.jobs import mill
+    from yadebreak.studies.grinding.spectra import read_spectra
     brk, summary = mill.run(_args(tmp_path, breakage=False, vtk_interval=0.0), quiet=True)
     assert summary["breakage"] is False and summary["end_reason"] == "finished"
     assert summary["breakage_events"] == summary["damage_events"] == 0

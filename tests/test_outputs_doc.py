@@ -54,7 +54,7 @@ def test_dotted_names():
 
 
 def test_class_codes_are_the_engines():
-    from yadebreak.coupling.state import KINDS
+    from yadebreak.engine.state import KINDS
     rows = re.findall(r"^\| (\d+) \| `(\w+)` \|", DOC.read_text(), re.M)
     assert [(int(code), kind) for code, kind in rows] == list(enumerate(KINDS))
 

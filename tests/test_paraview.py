@@ -51,14 +51,14 @@ def read_vtp(path):
 def bed_run(tmp_path_factory):
     """One tiny bed impact with a frame every INTERVAL (the YADE scene reset before and after)."""
     from yade import O
-    from yadebreak.runs import bed
-    from yadebreak import coupling
+    from yadebreak.jobs import bed
+    from yadebreak import engine
     out = tmp_path_factory.mktemp("bed")
-    coupling.forget()
+    engine.forget()
     O.reset()
     brk, summary = bed.run(_args(out), quiet=True)
     final_spheres = sorted(b.id for b in O.bodies if b is not None and hasattr(b.shape, "radius"))
-    coupling.forget()
+    engine.forget()
     O.reset()
     return out, brk, summary, final_spheres
 
@@ -134,7 +134,7 @@ def test_anvil_is_a_square_under_the_bed(bed_run):
 
 
 def test_interval_zero_writes_no_series_and_a_bad_one_is_refused(scene, tmp_path):
-    from yadebreak.runs import paraview
+    from yadebreak.jobs import paraview
     frames = paraview.series(tmp_path / "none", None, 0.0)
     frames()
     frames.close()

@@ -12,8 +12,8 @@ SIZE = 5.5e-3
 
 
 def _bed(cache, **kw):
-    from yadebreak import coupling, scenes
-    coupling.forget()
+    from yadebreak import engine, scenes
+    engine.forget()
     return scenes.bed_impact_scene(rings=1, layers=3, energy=1.0, bed_cache=str(cache), **kw)
 
 
@@ -54,7 +54,7 @@ def test_poured_only_for_several_layers(scene, tmp_path):
 def test_the_run_reports_its_bed_and_rolling_friction(scene, tmp_path):
     """summary.json: bed_packing, the bed's kinetic energy at the ball's touch (a settled bed is
     at rest: below 1e-6 of the impact energy) and the rolling friction of each pair."""
-    from yadebreak.runs import bed
+    from yadebreak.jobs import bed
     args = argparse.Namespace(material="copper_ore", size=SIZE, rings=1, layers=3, energy=1.0,
                               speed=0.0, seed=1, time_step_fraction=0.05, dmin=0.0,
                               global_damping=0.0, dummies="ledger", read_period="fast",
@@ -71,9 +71,9 @@ def test_the_run_reports_its_bed_and_rolling_friction(scene, tmp_path):
 
 def _run(tmp_path, name, **kw):
     from yade import O
-    from yadebreak.runs import bed
-    from yadebreak import coupling
-    coupling.forget()
+    from yadebreak.jobs import bed
+    from yadebreak import engine
+    engine.forget()
     O.reset()
     values = dict(material="copper_ore", size=SIZE, rings=2, layers=1, energy=1.0, speed=0.0,
                   seed=1, time_step_fraction=0.05, dmin=0.0, global_damping=0.0,

@@ -9,13 +9,13 @@ pytestmark = pytest.mark.yade
 
 
 def _impacts(breakage, speeds):
-    from yadebreak import coupling, scenes
-    from yadebreak.coupling.yade_api import O
+    from yadebreak import engine, scenes
+    from yadebreak.adapter.yade_api import O
     brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, speeds=speeds, emin=0.0, seed=4,
                                    breakage=breakage)
     before = {i: brk.bodies[i].fracture_energy for i in ids}
     bodies = len(O.bodies)
-    coupling.run_steps(2000)
+    engine.run_steps(2000)
     return brk, ids, before, bodies, len(O.bodies)
 
 

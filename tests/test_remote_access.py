@@ -90,7 +90,7 @@ def test_a_pool_worker_closes_them_too(tmp_path):
     os.mkfifo(tmp_path / "set" / "spec.json")
     (tmp_path / "queue" / "0").write_text(json.dumps({"set": str(tmp_path / "set"), "scene": 0}))
     proc = subprocess.Popen(["yade", "-n", "-x",
-                             str(ROOT / "yadebreak" / "runs" / "impact_worker.py"),
+                             str(ROOT / "yadebreak" / "jobs" / "impact_worker.py"),
                              str(tmp_path), "0", str(ROOT)], cwd=tmp_path,
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:

@@ -10,13 +10,13 @@ pytestmark = pytest.mark.yade
 def _free_sphere(radius=5e-3, vel=(0, 0, 0), angvel=(0, 0, 0), **options):
     """One copper-ore sphere in free space (no gravity, no wall)."""
     from yade import O, utils
-    from yadebreak import coupling, scenes
-    ip2, _ = coupling.add_materials({"ore": "copper_ore"})
+    from yadebreak import engine, scenes
+    ip2, _ = engine.add_materials({"ore": "copper_ore"})
     bid = O.bodies.append(utils.sphere((0.01, -0.02, 0.03), radius, material="ore"))
     O.bodies[bid].state.vel = vel
     O.bodies[bid].state.angVel = angvel
     O.engines = scenes.hertz_engines(ip2)
-    brk = coupling.attach({"ore": "copper_ore"}, seed=4, **options)
+    brk = engine.attach({"ore": "copper_ore"}, seed=4, **options)
     return brk, bid
 
 
@@ -58,8 +58,8 @@ def test_zeroed_overlaps_keep_fragments_at_rest_and_without_zeroing_they_fly(sce
     results = {}
     for zero in (True, False):
         O.reset()
-        from yadebreak import coupling
-        coupling.forget()
+        from yadebreak import engine
+        engine.forget()
         brk, bid = _free_sphere(zero_overlaps=zero)
         brk.break_body(bid, ratio=3.0)
         peak = 0.0
@@ -153,7 +153,7 @@ def test_softer_dummies_differ_from_their_parent_in_stiffness_only(scene):
     reader sees the dummies' own stiffness (Eq. 4 against them: e = 1 / (1 + kp / kd)); and the
     time step follows the finest of each material (a softer dummy allows a longer one)."""
     from yade import O
-    from yadebreak.coupling.scene_materials import DUMMY_SUFFIX
+    from yadebreak.engine.materials import DUMMY_SUFFIX
     brk, bid = _free_sphere(radius=10e-3, dummy_stiffness=0.1)
     ore = O.bodies[bid].material
     soft = next(m for m in O.materials if m.label == "ore" + DUMMY_SUFFIX)
@@ -181,7 +181,7 @@ def test_softer_dummies_differ_from_their_parent_in_stiffness_only(scene):
 
 
 def test_a_dummy_stiffness_out_of_range_is_refused_in_one_line():
-    from yadebreak.coupling import config
+    from yadebreak.options import table as config
     with pytest.raises(config.AttachError) as err:
         config.Config.from_options(dummy_stiffness=0.0)
     assert "dummy_stiffness = 0.0: accepted (0, 1]" in str(err.value)

@@ -73,8 +73,8 @@ def test_a_bed_killed_after_its_checkpoint_resumes_to_the_same_run(scene, tmp_pa
     summary is the uninterrupted one's, its events are the same events (kind, body, step; those
     closed at the last step in any order) with the same numbers, and no event or frame of the
     killed run is left."""
-    from yadebreak.runs import bed
-    from yadebreak import coupling
+    from yadebreak.jobs import bed
+    from yadebreak import engine as coupling
 
     def run(out, **changes):
         coupling.forget()
@@ -118,7 +118,7 @@ def test_zeroed_overlaps_go_on_after_a_reload_as_if_never_saved(scene, tmp_path)
     O.load keeps neither a wall pair's overlap (NaN until the next InteractionLoop, but the zeroing
     reads it before: it would make NaN forces) nor which pairs sleep and since when."""
     from yade import utils
-    from yadebreak import coupling
+    from yadebreak import engine as coupling
     from yadebreak.scenes.impacts import hertz_engines
     ip2, _ = coupling.add_materials({"ore": "copper_ore", "steel": "steel"})
     wall = scene.bodies.append(utils.wall(0.0, axis=2, sense=1, material="steel"))
@@ -153,8 +153,8 @@ def test_a_bed_resumed_from_any_cut_is_the_uninterrupted_run(scene, tmp_path):
     (coupling.reload) every cut ended with other events (41 against 42 or 43, the first moved by
     14 steps or more): the resumed collider made YADE's potential contacts anew in another order,
     so forces were summed in another order and the impact grew the last bit."""
-    from yadebreak.runs import bed
-    from yadebreak import coupling
+    from yadebreak.jobs import bed
+    from yadebreak import engine as coupling
 
     def run(out, **changes):
         coupling.forget()
@@ -179,9 +179,10 @@ def test_a_checkpoint_keeps_the_last_read_and_the_rolling_checks(scene, tmp_path
     read (the next read's interval, hence its first-touch work and the "fast" period) and the
     rolling friction part where its checks are (which one passes over every interaction, the
     counts the next compares with): the state the saved run had, not a fresh one's."""
-    from yadebreak import coupling
-    from yadebreak.coupling import engine, rolling
-    from yadebreak.runs import bed
+    from yadebreak import engine as coupling
+    from yadebreak.engine import scene as engine
+    from yadebreak.engine.parts import rolling
+    from yadebreak.jobs import bed
     out = tmp_path / "cut"
     coupling.forget()
     assert bed.run(_bed_args(out, vtk_interval=0.0, checkpoint_every=0.0, stop_after=6e-4),

@@ -16,11 +16,11 @@ def _rolling_sphere(scene, plate, v0, radius=0.01, stiffness_scale=1e-3):
     `plate` ("steel": the particle-steel pair; "ore": particle-particle), resting at its
     equilibrium overlap under gravity. Returns (sphere, rolling friction of the pair)."""
     from yade import utils
-    from yadebreak import coupling, scenes
+    from yadebreak import engine, scenes
     from yadebreak.model import placement
-    from yadebreak.coupling.scene_materials import rolling_friction
+    from yadebreak.engine.materials import rolling_friction
     labels = {"ore": "copper_ore", "steel": "steel"}
-    ip2, mats = coupling.add_materials(labels, stiffness_scale=stiffness_scale)
+    ip2, mats = engine.add_materials(labels, stiffness_scale=stiffness_scale)
     table, named = rolling_friction(labels)
     scene.bodies.append(utils.wall(0.0, axis=2, sense=1, material=plate))
     ore = mats["ore"]
@@ -78,14 +78,14 @@ def test_each_pair_of_a_bed_gets_its_own_coefficient(scene):
     0.27, particle-steel 0.01 from the files; 0.33 where --steel-rolling-friction replaces it),
     capped at mu_r F_n R with R the smaller sphere's radius, and a rolling stiffness."""
     from yade import O
-    from yadebreak import coupling, scenes
+    from yadebreak import engine, scenes
     for steel, expected_steel in ((None, 0.01), (0.33, 0.33)):
-        coupling.forget()
+        engine.forget()
         brk, info = scenes.bed_impact_scene(rings=1, energy=1.0, steel_rolling_friction=steel,
                                             read_period=1)
         assert info["rolling_friction"] == {"particle_particle": 0.27,
                                             "particle_steel": expected_steel}
-        coupling.run_steps(3000)
+        engine.run_steps(3000)
         seen = {"ore-ore": [], "ore-steel": []}
         for i in O.interactions:
             if not i.isReal:

@@ -2,7 +2,7 @@
 the value, the range and the unit; exit code 2; no traceback), units may be written
 (`--size 5.5mm`), --help shows units and defaults, and the bed's --resume refuses other arguments
 and says when the run had finished. The options are read in this process, as each script reads
-them (yadebreak.runs.job_options); one script run as users run it shows that the scripts wire
+them (yadebreak.jobs.options); one script run as users run it shows that the scripts wire
 them through."""
 import json
 import os
@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from yadebreak.runs import job_options
-from yadebreak.tools.options import ParamError, numbers, number, script_params
+from yadebreak.jobs import options as job_options
+from yadebreak.options.flags import ParamError, numbers, number, script_params
 
 ROOT = Path(__file__).resolve().parent.parent
 PYTHON = "/usr/bin/python3"
@@ -105,7 +105,7 @@ def test_speeds_below_the_wave_speed_are_accepted():
 
 
 def test_jobs_default_to_the_usable_cores():
-    from yadebreak.runs.verify import PARAMS
+    from yadebreak.studies.verify import PARAMS
     cores = len(os.sched_getaffinity(0))
     assert job_options.read("single_impact", None, []).jobs == cores
     assert [p.default for p in PARAMS if p.name == "jobs"] == [cores]
@@ -129,7 +129,7 @@ def test_a_tables_unknown_column_is_named_in_one_line(monkeypatch, capsys):
 @pytest.mark.parametrize("text_value, minutes", [("10", 10.0), ("90s", 1.5), ("90 s", 1.5),
                                                  ("1h", 60.0), ("2 min", 2.0)])
 def test_minutes_take_a_time_unit(text_value, minutes):
-    from yadebreak.__main__ import COMMANDS
+    from yadebreak.cli import COMMANDS
     option = next(p for p in COMMANDS["grind"][2] if p.name == "minutes")
     assert option.convert(text_value) == minutes
     with pytest.raises(ParamError, match=r"--minutes = 5 m: .*\(min\); the unit 'm' is not "):
@@ -221,13 +221,13 @@ def test_help_shows_units_and_defaults(capsys, script, shown):
 def test_bed_resume_refuses_other_arguments_and_says_when_finished(scene, tmp_path, capsys):
     """The bed's options read as its script reads them, run as its script runs them
     (run_script), in this process."""
-    from yadebreak import coupling
-    from yadebreak.runs import bed
-    from yadebreak.tools.lifecycle import run_script
+    from yadebreak import engine
+    from yadebreak.jobs import bed
+    from yadebreak.jobs.lifecycle import run_script
 
     def _bed(out, *extra):
         """(exit code, what the run printed)."""
-        coupling.forget()
+        engine.forget()
         scene.reset()
         args = job_options.read("bed_impact", None, ["--rings", "1", "--energy", "0.5", "--out",
                                                      str(out), *extra])

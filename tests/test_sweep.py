@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from yadebreak.tools import sweep
+from yadebreak.studies import sweep
 
 ROOT = Path(__file__).resolve().parent.parent
 SCRIPT = ROOT / "scripts" / "single_impact.py"

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from yadebreak.tools import tradeoff as to
+from yadebreak.studies import tradeoff as to
 
 ROOT = Path(__file__).resolve().parent.parent
 

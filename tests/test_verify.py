@@ -1,4 +1,4 @@
-"""`python3 -m yadebreak verify --quick 1` (yadebreak/runs/verify/): the paper's Section 4.1
+"""`python3 -m yadebreak verify --quick 1` (yadebreak/studies/verify/): the paper's Section 4.1
 subset runs, writes its report and plots, its probabilities (single impacts, drop weight, four
 targets, three sizes, repeated impacts) sit within the binomial 3 sigma of the model for those
 very cases, two restitutions give the same probability within 3 sigma of their difference, and
@@ -9,7 +9,7 @@ import json
 
 import pytest
 
-from yadebreak.runs import verify
+from yadebreak.studies import verify
 
 pytestmark = pytest.mark.yade
 
@@ -116,7 +116,7 @@ def test_runs_queued_together_in_a_pool_give_what_they_give_one_by_one(scene):
     two worker processes, the costliest first: every result is the one the runs give one after
     the other in this process, to the last digit (but the time taken); each set ran once, and
     the pool is gone after close()."""
-    from yadebreak.runs.verify.settings import Run, Runner, paper_options
+    from yadebreak.studies.verify.settings import Run, Runner, paper_options
     runs = [Run("copper_ore", 5.5e-3, [700.0, 1500.0], 3, 4,
                 paper_options(0.05, read_period="fast")),
             Run("copper_ore", 5.5e-3, [400.0], 6, 4, paper_options(0.05, replace=False),
@@ -149,9 +149,9 @@ def test_the_plan_holds_every_figure_s_first_runs_and_leaves_no_plot_open(tmp_pa
     (2 % RT with the file's damping, 5 % RT, damping 0, cs 1; the drop weight), Figs. 8-10 to
     their probability
     runs; Fig. 11 runs in this process and is not in it; no figure is left open."""
-    from yadebreak.runs.verify.report import plt_module
-    from yadebreak.runs.verify.settings import plan
-    from yadebreak.tools.options import ScriptParser, add_params, read_params
+    from yadebreak.studies.verify.report import plt_module
+    from yadebreak.studies.verify.settings import plan
+    from yadebreak.options.flags import ScriptParser, add_params, read_params
     parser = ScriptParser(prog="verify")
     add_params(parser, verify.PARAMS)
     args = read_params(parser.parse_args(["--quick", "1", "--out", str(tmp_path)]), verify.PARAMS)

@@ -1,14 +1,19 @@
 """yadebreak: the Tavares UFRJ particle-breakage model for YADE.
 
-The package in layers (docs/architecture.md):
+The package by concern (docs/architecture.md):
 
     model/     the breakage model in numpy/scipy (equations, materials, families, placement, ...)
-    tools/     options, sweeps, the trade-off, calibration, grinding: plain Python
-    coupling/  the engine inside YADE's loop; coupling/yade_api.py is the one module importing yade
-    scenes/    builders of YADE scenes (impacts, beds, ...)
-    runs/      the jobs behind scripts/ (bed, mill, agglomerate, extremes)
+    criteria/  when a body breaks and what it leaves: one class per criterion
+    options/   the engine's option table and the flags of scripts and tools
+    analysis/  results against the model, and their plots
+    adapter/   yade_api.py, the one module that imports yade
+    engine/    the engine and its parts in YADE's loop
+    scenes/    every builder of a YADE scene
+    jobs/      the jobs behind scripts/ and their lifecycle
+    studies/   verify, calibration, grinding, sweeps, the trade-off
+    cli.py     python3 -m yadebreak
 
-`import yadebreak` needs only numpy and scipy: `attach` and `save` import the coupling (and YADE)
+`import yadebreak` needs only numpy and scipy: `attach` and `save` import the engine (and YADE)
 on first use.
 """
 from importlib import import_module
@@ -16,6 +21,9 @@ from importlib import import_module
 from yadebreak.model.materials import (Material, MaterialError, available_materials,
                                        load_material, material_search_path)
 from yadebreak import model
+from yadebreak._moved import install as _install_moved
+
+_install_moved()
 
 __version__ = "0.3.0"
 
@@ -25,13 +33,13 @@ __all__ = ["Material", "MaterialError", "available_materials", "load_material",
 # where the modules of version 0.2 went: `from yadebreak import families` keeps working
 _MOVED = {"materials": "model.materials", "families": "model.families",
           "placement": "model.placement", "bonds": "model.bonds", "milling": "model.milling",
-          "intervals": "model.intervals", "reports": "model.reports",
+          "intervals": "model.intervals", "reports": "analysis.reports",
           "scenes": "scenes", "poured_bed": "scenes.poured_bed",
-          "bed": "runs.bed", "mill": "runs.mill", "agglomerate": "runs.agglomerate",
-          "extremes": "runs.extremes", "paraview": "runs.paraview",
-          "scriptargs": "tools.options", "sweep": "tools.sweep", "tradeoff": "tools.tradeoff",
-          "calibration": "tools.calibration", "grinding": "tools.grinding",
-          "yadepath": "coupling.yadepath"}
+          "bed": "jobs.bed", "mill": "jobs.mill", "agglomerate": "jobs.agglomerate",
+          "extremes": "jobs.extremes", "paraview": "jobs.paraview",
+          "scriptargs": "options.flags", "sweep": "studies.sweep", "tradeoff": "studies.tradeoff",
+          "calibration": "studies.calibration", "grinding": "studies.grinding",
+          "yadepath": "adapter.yadepath"}
 
 
 def __getattr__(name):
@@ -41,12 +49,12 @@ def __getattr__(name):
 
 
 def attach(*args, **kwargs):
-    """Register the breakage engine in the current YADE scene (see yadebreak.coupling.attach)."""
-    from yadebreak.coupling import attach as _attach
+    """Register the breakage engine in the current YADE scene (see yadebreak.engine.attach)."""
+    from yadebreak.engine import attach as _attach
     return _attach(*args, **kwargs)
 
 
 def save(path):
-    """O.save the scene with yadebreak's state (see yadebreak.coupling.save)."""
-    from yadebreak.coupling import save as _save
+    """O.save the scene with yadebreak's state (see yadebreak.engine.save)."""
+    from yadebreak.engine import save as _save
     return _save(path)

@@ -44,7 +44,7 @@ def run(seed, script, *options):
     sys.argv = [script, *options]
     sys.path.insert(0, str(Path(script).resolve().parent.parent))
     from yadebreak.scenes import beds, impacts
-    from yadebreak.coupling.yade_api import O
+    from yadebreak.adapter.yade_api import O
     hook = nudging(impacts.attach, int(seed), O)
     impacts.attach = beds.attach = hook               # looked up at each call
     main = sys.modules["__main__"].__dict__

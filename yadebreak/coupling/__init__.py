@@ -1,29 +1,4 @@
-"""The YADE coupling: the only part of yadebreak that imports yade.
-
-    brk = yadebreak.attach(materials={"ore": "copper_ore"}, seed=1)   # after O.engines is set
-    coupling.run_steps(20000); brk.events; brk.size_distribution([1e-3])
-    yadebreak.save("scene.yade.gz")                                   # O.save with the state
-
-One step's data, in the order the engine (controller.py) moves it: contacts.py reads YADE's
-interactions into per-body loading; judging.py and criteria.py decide; state.py keeps bodies,
-events and the fines ledger; replacement.py and zeroing.py put the progeny in; stepping.py sets
-the time step and the next read; engine.py attaches it all and saves it with the scene;
-config.py holds the options. config, state, contacts, criteria and judging never import yade
-(they are tested without it); the names below that need YADE import it on first use.
-"""
-from importlib import import_module
-
-from yadebreak.coupling.config import AttachError, Config, options_markdown
-
-_NEED_YADE = {"attach": "engine", "controller_of": "engine", "detach": "engine", "forget": "engine",
-              "load_checkpoint": "engine", "reload": "engine", "run_steps": "engine",
-              "save": "engine", "save_checkpoint": "engine", "Controller": "controller",
-              "add_materials": "scene_materials"}
-
-__all__ = ["AttachError", "Config", "options_markdown", *_NEED_YADE]
-
-
-def __getattr__(name):
-    if name in _NEED_YADE:
-        return getattr(import_module(f".{_NEED_YADE[name]}", __name__), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+"""Entry points that saved scenes name: a checkpoint's PyRunner commands call
+`yadebreak.coupling.engine.on_read`, `.on_zero`, `yadebreak.coupling.rolling.on_step` and
+`yadebreak.coupling.bonded.on_step`. These modules forward to the engine (yadebreak.engine) and
+stay for good, so that every saved scene resumes. New code imports yadebreak.engine."""

@@ -13,5 +13,5 @@ milling     the laboratory ball mill's classical relations (critical speed, Bond
 reports     impact-test results against the model (probability, t10, progeny)
 intervals   the accepted ranges of every number, one home for the check and its wording
 """
-from .equations import *  # noqa: F401,F403 (the equations are the model's public face)
-from .equations import __all__  # noqa: F401
+from yadebreak.model.equations import *  # noqa: F401,F403 (the equations are the model's public face)
+from yadebreak.model.equations import __all__  # noqa: F401

@@ -22,8 +22,8 @@ from scipy import sparse, stats
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
-from .intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS
-from .materials import (MaterialError, _check_keys, _find, _number, _read_table,
+from yadebreak.model.intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS
+from yadebreak.model.materials import (MaterialError, _check_keys, _find, _number, _read_table,
                         available_materials, in_file_unit)
 
 #: failure modes, as stored per bond (index) and written in outputs (name)

@@ -23,7 +23,7 @@ import numpy as np
 from scipy.optimize import linprog
 from scipy.spatial import ConvexHull, HalfspaceIntersection, QhullError
 
-from .equations import fines_passing, progeny_passing
+from yadebreak.model.equations import fines_passing, progeny_passing
 
 __all__ = ['ConvexPolyhedron', 'convex_polyhedron', 'polyhedron_mass_properties', 'sieve_size',
            'laguerre_cells', 'WeightSolution', 'solve_weights', 'progeny_law', 'target_sizes',

@@ -41,7 +41,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from yadebreak import model
-from .cache import cache_folder
+from yadebreak.model.cache import cache_folder
 
 #: Class sizes x_k = 2^(-k/4), k = 0..9, then the dummy class at x_9 (Table 2).
 CLASS_SIZES = 2.0 ** (-np.arange(10) / 4.0)

@@ -44,7 +44,7 @@ class Interval:
 
 
 # -- physical ranges of material properties (SI) ---------------------------------------------------
-# Material files (materials.py, bonds.py) and the scene's YADE materials (coupling/scene_materials)
+# Material files (materials.py, bonds.py) and the scene's YADE materials (engine/materials.py)
 # are checked against these before a run. Within them the Rayleigh time of a sphere of radius R
 # lies between 4.1e-5 R and 2.9 R s (R in m): the time step is finite and positive for any size.
 #: kg/m3: from polymer foams and wood (~100) to the densest metals (osmium, 22,600)

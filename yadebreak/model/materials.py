@@ -21,7 +21,7 @@ from typing import Mapping
 import numpy as np
 
 from yadebreak import model
-from .intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS, InputError
+from yadebreak.model.intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS, InputError
 
 #: the materials shipped with the package
 MATERIALS_DIR = Path(__file__).resolve().parent.parent / "data" / "materials"

@@ -1,14 +1,14 @@
 """Builders of YADE scenes (YADE layer): each returns the attached engine and what the job
-needs to measure. A new scene goes here; the job that runs it goes in yadebreak.runs.
+needs to measure. A new scene goes here; the job that runs it goes in yadebreak.jobs.
 
 impacts     particles shot at a target, repeated impacts, the drop weight; the shared engines
 impact_pool YADE worker processes running impact scenes from a queue (no yade import here)
 beds        a ball on a bed of particles (lattice or poured)
 poured_bed  beds poured and settled under gravity, and their cache
 """
-from .beds import (BALL_DIAMETER, BALL_MASS, bed_impact_scene,  # noqa: F401
+from yadebreak.scenes.beds import (BALL_DIAMETER, BALL_MASS, bed_impact_scene,  # noqa: F401
                    hex_bed_positions, hold_release)
-from .impacts import (drop_weight_scene, drop_weight_spec, hertz_engines,  # noqa: F401
+from yadebreak.scenes.impacts import (drop_weight_scene, drop_weight_spec, hertz_engines,  # noqa: F401
                       impact_again, impact_scene, impact_spec, run_drop_weight, run_scenes,
                       run_until_rebound, scene_seed, single_impacts)
-from .impact_pool import ImpactPool  # noqa: F401
+from yadebreak.scenes.impact_pool import ImpactPool  # noqa: F401

@@ -7,11 +7,11 @@ import math
 
 import numpy as np
 
-from yadebreak.coupling import add_materials, attach
-from yadebreak.coupling.scene_materials import rolling_friction
-from yadebreak.coupling.yade_api import O, geom, utils
+from yadebreak.engine import add_materials, attach
+from yadebreak.engine.materials import rolling_friction
+from yadebreak.adapter.yade_api import O, geom, utils
 from yadebreak.model.intervals import BALL_DIAMETER, BALL_MASS  # noqa: F401 (the paper's ball)
-from .impacts import hertz_engines
+from yadebreak.scenes.impacts import hertz_engines
 
 
 def hex_bed_positions(size, rings, layers=1, gap=0.01):
@@ -58,7 +58,7 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
     above the bed with the speed of its drop, v = sqrt(2 E / m). Returns (controller, info).
     """
     from yadebreak.scenes import poured_bed
-    from yadebreak.coupling.engine import YADE_DEFAULT_DT
+    from yadebreak.engine.scene import YADE_DEFAULT_DT
     packing = packing or ("poured" if layers > 1 else "lattice")
     if packing not in ("poured", "lattice") or (packing == "poured" and layers < 2):
         raise ValueError(f"packing {packing!r}: 'lattice', or 'poured' for beds of 2 layers or "
@@ -150,7 +150,7 @@ def _holder(radius, height):
 
 
 def _material(name):
-    from yadebreak.coupling.scene_materials import _as_material
+    from yadebreak.engine.materials import _as_material
     return _as_material(name)
 
 

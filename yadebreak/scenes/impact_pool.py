@@ -13,7 +13,7 @@ worker claims one by renaming it (atomic: two workers never run the same scene).
 the scene's events to <set>/<k>.jsonl, then its tally to <set>/<k>.tally.json (that file says the
 scene is done); the parent merges the tallies in scene order, so the result is that of the scenes
 run one after the other in one process, whatever worker ran which (tests/test_high_energy.py).
-Scenes layer: the workers import yade (runs/impact_worker.py), this module does not.
+Scenes layer: the workers import yade (jobs/impact_worker.py), this module does not.
 """
 from __future__ import annotations
 
@@ -71,7 +71,7 @@ class ImpactPool:
         on_scene(scenes done, scenes, tally so far) as they end; on_wait(scenes started, scenes
         submitted), both counted over every set, every `wait_every_s` of waiting. A failed worker
         stops the pool and raises with its last words."""
-        from yadebreak.model.reports import ImpactTally
+        from yadebreak.analysis.reports import ImpactTally
         n = len(impact_set.spec["counts"])
         tallies, reported = {}, 0
         told = time.time()
@@ -123,8 +123,8 @@ class ImpactPool:
         (self.folder / "queue.tmp").mkdir()
         (self.folder / "claimed").mkdir()
         package = str(Path(__file__).resolve().parents[2])
-        worker = str(Path(__file__).resolve().parents[1] / "runs" / "impact_worker.py")
-        from yadebreak.tools.sweep import die_with_parent  # a parent killed (even -9) takes them
+        worker = str(Path(__file__).resolve().parents[1] / "jobs" / "impact_worker.py")
+        from yadebreak.studies.sweep import die_with_parent  # a parent killed (even -9) takes them
         self._errors = [open(self.folder / f"{j}.err", "w") for j in range(self.jobs)]
         self._procs = [subprocess.Popen(["yade", "-n", "-x", worker, str(self.folder), str(j),
                                          package],
@@ -152,7 +152,7 @@ class ImpactSet:
 
 
 def _merged(size, tallies):
-    from yadebreak.model.reports import ImpactTally
+    from yadebreak.analysis.reports import ImpactTally
     tally = ImpactTally(size)
     for k in sorted(tallies):
         tally.merge(tallies[k])

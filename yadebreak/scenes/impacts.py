@@ -11,16 +11,16 @@ import numpy as np
 
 # the coupling makes yade importable from Debian's python3 first
 from yadebreak.model import placement
-from yadebreak.coupling import add_materials, attach, run_steps
-from yadebreak.coupling.rolling import rolling_engine
-from yadebreak.coupling.yade_api import O, utils, wrapper as _w
-from yadebreak.tools.lifecycle import append_whole, stop_point, stop_points
+from yadebreak.engine import add_materials, attach, run_steps
+from yadebreak.engine.parts.rolling import rolling_engine
+from yadebreak.adapter.yade_api import O, utils, wrapper as _w
+from yadebreak.jobs.lifecycle import append_whole, stop_point, stop_points
 
 
 def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False, rolling=None):
     """The standard engine list: collider, Hertz-Mindlin, undamped Newton; with `rolling`
     ({(material id, id): mu_r}, scene_materials.rolling_friction), the law's contact moment and
-    the part that gives each contact its pair's rolling friction (coupling/rolling.py)."""
+    the part that gives each contact its pair's rolling friction (engine/parts/rolling.py)."""
     bounds = [_w.Bo1_Sphere_Aabb(), _w.Bo1_Wall_Aabb()]
     geoms = [_w.Ig2_Sphere_Sphere_ScGeom(), _w.Ig2_Wall_Sphere_ScGeom()]
     if facets:
@@ -97,7 +97,7 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     if pool is not None:
         return pool.collect(pool.submit(spec, event_log), on_scene), None
     if jobs > 1 and len(spec["counts"]) > 1:
-        from .impact_pool import ImpactPool
+        from yadebreak.scenes.impact_pool import ImpactPool
         with ImpactPool(min(jobs, len(spec["counts"]))) as own:
             return own.collect(own.submit(spec, event_log), on_scene), None
     if event_log is not None:
@@ -132,7 +132,7 @@ def _scene_counts(particles, per_scene):
 def run_scenes(spec, which, event_log=None, on_scene=None):
     """The scenes `which` of an impact_spec or drop_weight_spec, one after the other, their
     events appended to `event_log`: (tally, the last scene's controller)."""
-    from yadebreak.model.reports import ImpactTally
+    from yadebreak.analysis.reports import ImpactTally
     tally = ImpactTally(spec["size"])
     log = None if event_log is None else Path(event_log)
     live = None if log is None else log.with_suffix(".scene.jsonl")

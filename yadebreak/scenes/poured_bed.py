@@ -23,8 +23,8 @@ import os
 from pathlib import Path
 
 from yadebreak.model import cache, placement
-from yadebreak.coupling import rolling
-from yadebreak.coupling.yade_api import O, utils, wrapper
+from yadebreak.engine.parts import rolling
+from yadebreak.adapter.yade_api import O, utils, wrapper
 
 #: at rest: kinetic energy (translation and rotation) below REST_FRACTION N m g d
 REST_FRACTION = 1e-4

@@ -1,0 +1,58 @@
+"""The one module of yadebreak that imports yade (from Debian's python3 too: see
+yadebreak.adapter.yadepath). The coupling, scenes and runs take YADE's names from here."""
+from yadebreak.adapter.yadepath import ensure_yade_importable
+
+ensure_yade_importable()
+
+import yade.wrapper as wrapper  # noqa: E402
+from yade import O, Vector3, geom, utils  # noqa: E402
+
+__all__ = ["O", "Vector3", "close_remote_access", "current_scene", "find_engine", "geom",
+           "scene_folder", "table_row", "utils", "wrapper"]
+
+
+def find_engine(label):
+    """The engine of O.engines with this label, or None."""
+    return next((e for e in O.engines if getattr(e, "label", "") == label), None)
+
+
+def table_row(defaults):
+    """A yade-batch table row's values for these options ({name: default}; readParamsFromTable)
+    and the row's description (None outside a batch)."""
+    utils.readParamsFromTable(noTableOk=True, **defaults)
+    from yade.params import table      # exists once the row has been read
+    description = O.tags["description"] if "description" in O.tags.keys() else None
+    return {k: getattr(table, k) for k in defaults}, description
+
+
+def current_scene():
+    """The scene YADE runs now: equal (==) to an earlier result until O.reset() or O.load()
+    replaces it (a new scene, whatever its contents)."""
+    return O._sceneObj
+
+
+def scene_folder():
+    """The folder of the file the current scene was last saved to or loaded from (absolute), or
+    None for a scene never saved nor loaded: a saved run's own files are named relative to it."""
+    import os
+    name = O.filename
+    return os.path.dirname(os.path.abspath(name)) if name else None
+
+
+def close_remote_access():
+    """Close the two servers that the `yade` launcher starts at every start, `yade -n` included
+    (not `import yade`): a TCP Python prompt (port 9000 or up) guarded by a six-letter cookie
+    printed in the log, and an XMLRPC info server (21000 or up) with no guard that can pause the
+    run. The launcher says "localhost" but both listen on every interface. Returns the ports
+    closed (none outside the launcher)."""
+    import gc
+    import socketserver
+    import threading
+    ports = []
+    for server in [o for o in gc.get_objects() if isinstance(o, socketserver.BaseServer)]:
+        stopping = threading.Thread(target=server.shutdown, daemon=True)  # waits for its loop
+        stopping.start()
+        stopping.join(2.0)
+        server.server_close()
+        ports.append(server.server_address[1])
+    return sorted(ports)

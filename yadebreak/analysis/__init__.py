@@ -1,0 +1,1 @@
+"""Analysis of results: impact tests against the model, and their plots. Never imports yade."""

@@ -1,0 +1,1 @@
+"""Breakage criteria: when a body breaks and what it leaves (Tavares, Ab-T10, recording)."""

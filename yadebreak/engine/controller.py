@@ -1,0 +1,380 @@
+"""The per-step engine: read -> judge -> log -> replace (and zero) -> time step -> reschedule.
+
+One Controller per attached engine; `attach()` (engine.py) makes it and its PyRunners call
+`step()` after the InteractionLoop and the zeroing before it. Each part lives in its own module:
+contacts (reading), criteria (judging), state (bodies, events, ledger), replacement, zeroing,
+stepping (read schedule, time step, fragment damping).
+"""
+from __future__ import annotations
+
+import time
+import warnings
+
+import numpy as np
+
+from yadebreak.model import families, placement
+from yadebreak.analysis import reports
+from yadebreak.adapter.yade_api import O, utils
+from yadebreak.engine.contacts import ContactReader
+from yadebreak.criteria.engine_side import AbT10, criterion_for
+from yadebreak.engine.judging import Judge
+from yadebreak.engine.replacement import Replacer
+from yadebreak.engine.state import BREAKABLE, BROKEN, UNBREAKABLE, BodyRow, EngineState
+from yadebreak.engine.stepping import (FragmentDamping, Reach, ReadSchedule, SmallestBreakable,
+                                          TimeStep)
+from yadebreak.engine.zeroing import OverlapZeroing
+
+
+class YadebreakWarning(RuntimeWarning):
+    """A warning of yadebreak: its `cause` (one kind of trouble, e.g. "jump"), the message and the
+    remedies, attach() options that address it, best first, as (option, advice with {} where the
+    option's name goes). The text names the first; a script names the first it exposes
+    (for_script)."""
+
+    def __init__(self, cause, message, remedies=(), purpose=""):
+        self.cause, self.message, self.remedies, self.purpose = cause, message, list(remedies), purpose
+        first = self.remedies[0] if self.remedies else None
+        super().__init__(f"yadebreak: {self._text(first, str)}")
+
+    def _text(self, remedy, spell):
+        """The message with `remedy` (option, advice) advised, its option named by spell()."""
+        if remedy is None:
+            return self.message
+        option, advice = remedy
+        return f"{self.message}: {advice.format(spell(option))} {self.purpose}".rstrip()
+
+    def for_script(self, exposed):
+        """The message naming the first remedy among `exposed` (a script's option names), as its
+        command line spells it (--read-period); attach()'s name if it exposes none."""
+        mine = next((r for r in self.remedies if r[0] in exposed), None)
+        if mine is not None:
+            return self._text(mine, lambda o: "--" + o.replace("_", "-"))
+        return self._text(self.remedies[0] if self.remedies else None,
+                          lambda o: f"{o} (an attach() option)")
+
+
+class Controller:
+    """The engine of one scene: its state, its parts, and the results (`events`,
+    `size_distribution`, `body_state`)."""
+
+    def __init__(self, label, config, scene_materials, material_names, state=None):
+        self.label = label
+        self.config = config
+        self.material_names = dict(material_names)      # as given to attach (saved)
+        self.material = scene_materials.by_label         # YADE label -> Material
+        self.label_by_id = scene_materials.label_by_id
+        self.criteria = {lab: criterion_for(mat, config.criteria.breakage,
+                                            config.criteria.kappa_successive)
+                         for lab, mat in self.material.items()}
+        labels = list(self.material)
+        self.state = state or EngineState(labels, config.seed, config.output.event_log)
+        # criterion of each material index of the body table
+        self._criterion_of = [self.criteria[lab] for lab in self.state.table.labels]
+        self.pause_steps = {lab: (config.criteria.pause_steps if config.criteria.pause_steps
+                                  is not None else crit.default_pause_steps)
+                            for lab, crit in self.criteria.items()}
+        self.reader = ContactReader(scene_materials.stiffness_by_id, config.reading.cs,
+                                    config.reading.emin)
+        self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero",
+                                      config.replacement.zeroing_tolerance)
+        self.smallest = SmallestBreakable()
+        # "fast": the reach of a fresh contact over every tracked body
+        self.reach = Reach(config.reading.fast_tolerance) if config.reading.read_period == "fast" \
+            else None
+        self.schedule = ReadSchedule(config.reading, label, self._smallest_breakable,
+                                     self._reach if self.reach is not None else None)
+        self.time_step = TimeStep(config.time_step.time_step_fraction, self._warn_once)
+        gd = config.time_step.global_damping        # None: each material file's
+        self.damping = FragmentDamping(
+            {lab: (gd if gd is not None else mat.global_damping)
+             for lab, mat in self.material.items()}, config.time_step.global_damping_time)
+        tables = {lab: families.table_for(mat, config.replacement.family_seed)
+                  for lab, mat in self.material.items()}
+        dummy_material = (scene_materials.dummy_by_label
+                          if config.replacement.dummy_stiffness != 1.0 else {})
+        self.replacer = Replacer(config.replacement, self.state.table, self.state.rng,
+                                 self.criteria, tables, self.zeroing, self.reader,
+                                 self.state.ledger, self.pause_steps,
+                                 self.damping.damped_labels, dummy_material)
+        self.judge = Judge(self.state, self._criterion_of, self.reader,
+                           config.criteria.fragments_energy_factor,
+                           any(self.pause_steps.values()), config.reading.fast_tolerance,
+                           self._record, self._warn_jump,
+                           config.criteria.break_at == "peak")
+        self.judge.weakened = self._weakened
+        self.last_iter = -1
+        self.wall_time = {"read": 0.0, "replace": 0.0}
+        if self.reach is not None:            # a restored state: its tracked bodies
+            self._reach_rebuild()
+
+    # -- what users read ---------------------------------------------------------------------
+    @property
+    def bodies(self):
+        """The body table: bodies[i].fracture_energy etc. (state.BodyTable)."""
+        return self.state.table
+
+    @property
+    def events(self):
+        return self.state.log.events
+
+    @property
+    def breakage_events(self):
+        return [e for e in self.events if e["kind"] == "breakage"]
+
+    @property
+    def ledger(self):
+        return self.state.ledger
+
+    @property
+    def warned(self):
+        return self.state.warned
+
+    @property
+    def period(self):
+        """Steps between reads now."""
+        return self.schedule.period
+
+    @property
+    def zeroed(self):
+        """{(id_a, id_b): ZeroedOverlap} of the pairs whose artificial overlap is zeroed."""
+        return self.zeroing.pairs
+
+    def body_state(self, body_id):
+        """State of a body as a dict (fracture_energy, damage, kind, specific_energy...)."""
+        return self.state.table[body_id].as_dict()
+
+    def could_break(self, ids, more):
+        """Which of the bodies `ids` could break if their stressing event went on to count
+        `more` (J/kg, one per body) than it has now (Ek'/m at the last read), or be stressed past
+        their fracture energy for the first time if they are unbreakable fragments (that sets
+        their t10', hence their fines): tracked bodies whose criterion needs no more
+        (criteria: energy_to_break). Dummies never break. A scene's end rule asks it
+        (scenes.run_until_rebound)."""
+        table, tracked = self.state.table, self.state.tracked
+        c = table.columns
+        ids = np.asarray(ids, np.int64)
+        rows = np.flatnonzero(np.fromiter((i in tracked for i in ids.tolist()), bool, len(ids)))
+        need, now = np.full(len(ids), np.inf), np.zeros(len(ids))
+        now[rows] = c["specific_energy"][ids[rows]]
+        materials = c["material"][ids[rows]]
+        for m in np.unique(materials).tolist():
+            of_m = rows[materials == m]
+            need[of_m] = self._criterion_of[m].energy_to_break(table, ids[of_m])
+        return now + np.asarray(more, float) >= need
+
+    def total_mass(self):
+        """Mass (kg) of every body yadebreak knows, fragments and ledger fines included."""
+        return self.state.total_mass()
+
+    def size_distribution(self, sizes, fines=True, fines_model="gaudin_schuhmann"):
+        """The product size distribution, fines included (reports.product_size_distribution)."""
+        return reports.product_size_distribution(self.state.table, self.state.ledger,
+                                                 self.material, sizes, fines, fines_model)
+
+    # -- set-up --------------------------------------------------------------------------------
+    def register(self, spheres):
+        """Give the breakable spheres found at attach, [(id, label, mass (kg), radius (m))] in id
+        order, their state and fracture energy, drawn per material in id order."""
+        if not spheres:
+            return
+        ids = np.array([f[0] for f in spheres])
+        labels = [f[1] for f in spheres]
+        sizes = np.array([2.0 * f[3] for f in spheres])
+        table = self.state.table
+        for label in dict.fromkeys(labels):
+            idx = np.array([k for k, lab in enumerate(labels) if lab == label])
+            energies, extra = self.criteria[label].sample(self.state.rng, sizes[idx])
+            table.add(ids[idx], BREAKABLE, label, [spheres[k][2] for k in idx], sizes[idx] / 2.0,
+                      fracture_energy=energies, fracture_energy_initial=energies, **extra)
+        table.known = dict.fromkeys(ids.tolist())     # the scene's order (sums follow it)
+        self._adopt(ids.tolist())
+        self.state.top_size = max(self.state.top_size, float(sizes.max()))
+
+    def _adopt(self, ids):
+        """Track new bodies: breakable and unbreakable ones are read; breakable ones may set the
+        read schedule. Each YADE body gets its row as `body.breakage`."""
+        table = self.state.table
+        kind, radius = table.columns["kind"], table.columns["radius"]
+        for i in ids:
+            k = kind[i]
+            if k == BREAKABLE or k == UNBREAKABLE:
+                self.state.tracked.add(i)
+                if self.reach is not None:
+                    self._reach_add(i)
+            if k == BREAKABLE:
+                self.smallest.push(float(radius[i]), i)
+            O.bodies[i].breakage = BodyRow(table, i)
+
+    def _smallest_breakable(self):
+        return self.smallest.get(self._still_breakable)
+
+    def _reach(self, rebuild):
+        if rebuild:
+            self._reach_rebuild()
+        return self.reach.get(self.state.tracked)
+
+    def _reach_rebuild(self):
+        """The reach of every tracked body from the body table, material by material."""
+        c = self.state.table.columns
+        ids = np.array(sorted(self.state.tracked), np.int64)
+        onset, loading = np.empty(len(ids)), np.empty(len(ids))
+        materials = c["material"][ids]
+        for m in np.unique(materials).tolist():
+            rows = np.flatnonzero(materials == m)
+            mat = O.bodies[int(ids[rows[0]])].material
+            radius = c["radius"][ids[rows]]
+            onset[rows] = placement.hertz_onset_time(
+                radius, mat.density, mat.young, mat.poisson, 1.0,
+                self.reach.tolerance * c["fracture_energy"][ids[rows]])
+            loading[rows] = placement.hertz_loading_time(radius, mat.density, mat.young,
+                                                         mat.poisson, 1.0)
+        self.reach.rebuild(ids.tolist(), onset.tolist(), loading.tolist())
+
+    def _reach_add(self, i):
+        c = self.state.table.columns
+        self.reach.add(i, float(c["radius"][i]), float(c["fracture_energy"][i]),
+                       O.bodies[i].material)
+
+    def _weakened(self, i):
+        """A damage lowered body i's fracture energy: "fast" reads follow it."""
+        if self.reach is not None and i in self.state.tracked:
+            c = self.state.table.columns
+            self.reach.update(i, float(c["radius"][i]), float(c["fracture_energy"][i]),
+                              O.bodies[i].material)
+
+    def _still_breakable(self, i):
+        return i in self.state.tracked and self.state.table.columns["kind"][i] == BREAKABLE
+
+    def _warn_once(self, cause, message, remedies=(), purpose=""):
+        """A YadebreakWarning, once per cause for this controller (scripts: once per run)."""
+        if cause not in self.state.warned:
+            self.state.warned.add(cause)
+            warnings.warn(YadebreakWarning(cause, message, remedies, purpose), stacklevel=3)
+
+    # -- the per-step work -----------------------------------------------------------------------
+    def step(self):
+        """After the InteractionLoop, when the read schedule says: read -> judge -> log ->
+        replace -> time step -> reschedule."""
+        state = self.state
+        if not state.tracked and not state.open_events:
+            self.damping.release()
+            self.last_iter = O.iter               # nothing can break: next to no cost
+            return
+        t0 = time.perf_counter()
+        interval = max(1, O.iter - self.last_iter)        # steps since the last read
+        loading = self.reader.read(O.interactions, O.bodies, state.tracked, self.zeroing.pairs,
+                                   O.time, interval, self.zeroing.asleep,
+                                   utils.numIntrsOfEachBody)
+        self.wall_time["read"] += time.perf_counter() - t0
+        broken, limits = self.judge.judge(loading, interval, O.iter, self.schedule.mode == "fast")
+        if broken:
+            self._break_all(broken)
+        self.damping.release()
+        self.last_iter = O.iter
+        self.schedule.after_read(limits)
+
+    def _warn_jump(self, bid, rise, scale, ek):
+        """A body broke (or an unbreakable fragment was stressed past its fracture energy) after
+        its energy rose by `rise` (J/kg) between two reads, more than LATE_JUMP of its fracture
+        energy `scale`: its t10' is that of the read, where reading at the crossing gives the
+        criterion's t10' at its threshold (Eq. 8 at Ek'/(m E) = 1; Eq. 9.4 at e_cum = its
+        threshold). The message says both."""
+        table = self.state.table
+        crit = self.criteria[table.label_of(bid)]
+        ratio, t10, _ = crit.breakage(table, bid, ek)
+        if isinstance(getattr(crit, "inner", crit), AbT10):
+            low = float(crit.material.t10_of_cumulative_energy(
+                scale, 2.0 * float(table.columns["radius"][bid])))
+        else:
+            low = crit.breakage(table, bid, scale * float(table.columns["mass"][bid]))[1]
+        self._warn_once("jump", (
+            f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
+            f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s): "
+            f"its t10' is {t10:.2f} % (at {ratio:.2f} times its fracture energy) where a read at "
+            f"the crossing gives {low:.2f} %"),
+            remedies=self.schedule.remedies(), purpose="for an accurate t10'")
+
+    def _record(self, kind, bid, **fields):
+        c = self.state.table.columns
+        self.state.log.record({"kind": kind, "iter": O.iter, "time": O.time, "id": bid,
+                               "radius": float(c["radius"][bid]), "mass": float(c["mass"][bid]),
+                               **fields})
+
+    # -- breakage ---------------------------------------------------------------------------------
+    def _break_all(self, broken):
+        """Log each breakage, replace the spheres, then lower the time step for the finest
+        fragment (once for all the breakages of this read)."""
+        t0 = time.perf_counter()
+        state, table = self.state, self.state.table
+        c = table.columns
+        new_dt = np.inf
+        dmin = self.config.replacement.dmin
+        dmin = dmin if dmin is not None else state.top_size / 20.0
+        for bid, ek, strongest in broken:
+            if bid not in state.tracked:
+                continue
+            label = table.label_of(bid)
+            ratio, t10, extra = self.criteria[label].breakage(table, bid, ek)
+            state.tracked.discard(bid)
+            energy = float(c["fracture_energy"][bid])
+            specific = ek / float(c["mass"][bid])
+            if c["kind"][bid] == UNBREAKABLE:
+                c["t10"][bid] = t10                # keeps the t10' of its first would-be breakage
+                self._record("unbreakable_stressed", bid, specific_energy=specific,
+                             fracture_energy=energy, t10=t10)
+                continue
+            c["kind"][bid] = BROKEN
+            event = {"specific_energy": specific, "fracture_energy": energy, "ratio": ratio,
+                     "t10": t10, "generation": int(c["generation"][bid]), "fragments": [],
+                     "partner": -1 if strongest is None else int(strongest[3]), **extra}
+            if self.config.replacement.replace:
+                direction = (np.array([0.0, 0.0, 1.0]) if strongest is None
+                             else strongest[2] * np.array(strongest[1]))
+                progeny = self.replacer.replace(bid, t10, direction, dmin)
+                self.reader.erased(bid)
+                event.update(fragments=progeny.ids, family_t10=progeny.family_t10,
+                             fragment_speed_excess=progeny.speed_excess, **progeny.audit)
+                self._adopt(progeny.ids)
+                self.damping.add(progeny.ids)
+                self.schedule.saw_speed(max((O.bodies[i].state.vel.norm() for i in progeny.ids),
+                                            default=0.0))
+                for radius, material in progeny.smallest:
+                    new_dt = min(new_dt, self.time_step.for_fragments(radius, material))
+            self._record("breakage", bid, **event)
+        self.time_step.lower(new_dt, self.reader.bodies_in_contact)
+        self.wall_time["replace"] += time.perf_counter() - t0
+
+    def break_body(self, body_id, ratio=1.0, direction=(0.0, 0.0, 1.0)):
+        """Break a breakable body now, as if stressed to ratio = Ek'/(m E) (its criterion's t10')
+        along `direction`. Returns the breakage event."""
+        if body_id not in self.state.tracked or self.state.table.kind_of(body_id) != "breakable":
+            raise ValueError(f"body {body_id} is not a breakable body yadebreak tracks")
+        label = self.state.table.label_of(body_id)
+        ek = self.criteria[label].force(self.state.table, body_id, ratio)
+        self._break_all([(body_id, ek, (ek, direction, 1.0, -1))])   # no partner: asked for
+        return self.events[-1]
+
+    def finish(self):
+        """Close every open stressing event as if its body had unloaded (damage with the event's
+        largest energy; break_at="peak": a body past its threshold breaks), for runs stopped once
+        the loading is over. Returns how many."""
+        state = self.state
+        c = state.table.columns
+        event_max = c["event_max"]
+        cracked = sorted(i for i in state.open_events if i in state.tracked and c["cracked"][i])
+        if cracked:
+            self._break_all([(i, float(event_max[i]), None) for i in cracked])
+        closed = len(cracked)
+        for bid in list(state.open_events):
+            if bid in state.tracked and event_max[bid] > 0.0:
+                self.judge.close_event(bid)
+                closed += 1
+        state.open_events.clear()
+        return closed
+
+    def zero_overlaps(self):
+        """Before the InteractionLoop (see zeroing.py)."""
+        self.zeroing.apply()
+
+    def close(self):
+        self.state.log.close()

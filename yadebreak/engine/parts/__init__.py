@@ -1,0 +1,1 @@
+"""Parts that run in YADE's loop beside the breakage engine: rolling friction, the bond watch."""

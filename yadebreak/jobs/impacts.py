@@ -1,0 +1,256 @@
+"""The laboratory tests behind scripts/single_impact.py, repeated_impact.py and drop_weight.py
+(YADE layer: runs the scenes of yadebreak.scenes, writes outputs).
+
+single        particles fired at a plate at each energy (paper Figs. 8-10, 13-16)
+repeated      the same particles hit again and again at one energy (Fig. 11)
+drop_weight   a steel striker falls on each particle on an anvil (the paper's DWT, Figs. 8, 15)
+
+The energies of single impacts and drop-weight tests are independent units (skeleton.run_units:
+--resume 1 keeps those finished); repeated impacts are a Job checkpointed after every impact.
+"""
+import dataclasses
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from yadebreak import engine, scenes
+from yadebreak.adapter.yade_api import O
+from yadebreak.analysis import reports
+from yadebreak.model.materials import load_material
+from yadebreak.jobs import skeleton
+from yadebreak.jobs.lifecycle import (ScriptError, progress, resume_arguments, save_figure,
+                                       time_left, write_atomic)
+from yadebreak.options.flags import read_period_value
+
+
+def _energies(args):
+    """--energies as floats (J/kg)."""
+    return [float(e) for e in args.energies.split(",")]
+
+
+# -- single impacts -------------------------------------------------------------------------------
+def single(args):
+    """Every energy, then summary.json and the plot; returns the last scene's controller."""
+    mat, target = load_material(args.material), load_material(args.target)
+    out = Path(args.out)
+    start = time.time()
+
+    def write(results, end_reason, end_message):
+        """summary.json and, if an energy is done, the plot."""
+        summary = {"material": mat.name, "size": args.size, "target": args.target,
+                   "share_e": mat.energy_partition(target), "results": results,
+                   "runtime_s": time.time() - start, "end_reason": end_reason,
+                   "end_message": end_message}
+        write_atomic(out / "summary.json", json.dumps(summary, indent=2))
+        if results:
+            reports.plot_breakage(results, mat, args.size, target,
+                                  f"{mat.name}, {1e3 * args.size:g} mm on {args.target}",
+                                  out / "single_impact.png")
+
+    def limited(results):
+        at = [r["specific_energy"] for r in results if r["scenes_at_step_limit"]]
+        return f"scenes stopped at the step limit at {at} J/kg" if at else ""
+
+    brk = skeleton.run_units(
+        args, _energies(args), lambda k, energy: _impacts_at(args, mat, target, k, energy, out,
+                                                             start),
+        write, limited, validate=lambda energy, result: reports.check_breakage_result(
+            result, mat, args.size, float(energy), target, args.particles))
+    progress(f"wrote {out / 'summary.json'} and {out / 'single_impact.png'}")
+    return brk
+
+
+def _impacts_at(args, mat, target, k, energy, out, start):
+    """The particles fired at `energy` (J/kg) in scenes of --scene-particles: (the last scene's
+    controller, the energy's result)."""
+    speed = float(np.sqrt(2 * energy))
+    began, said = time.time(), [time.time()]
+
+    def on_scene(done, scenes_total, tally):
+        now = time.time()
+        if now - said[0] > 5.0 and done < scenes_total:
+            said[0] = now
+            progress(f"{energy:g} J/kg: scene {done}/{scenes_total}, {len(tally.broken)} of "
+                     f"{tally.particles} broken, {tally.breakage_events} breakages, "
+                     f"{time_left(now - began, done / scenes_total)} at this energy")
+
+    tally, brk = scenes.single_impacts(
+        args.material, args.size, speed, args.particles, args.scene_particles, args.seed + k,
+        target=args.target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
+        jobs=args.jobs, replace=args.replace, time_step_fraction=args.time_step_fraction,
+        read_period=read_period_value(args.read_period))
+    share = mat.energy_partition(target)
+    result = reports.breakage_result_of(tally, mat, energy, target)
+    intact = [e for e in tally.first if e["kind"] == "damage"]
+    result.update({
+        "speed": speed, "half_v_squared": energy, "steps": tally.steps, "scenes": tally.scenes,
+        "scenes_at_step_limit": tally.scenes_at_step_limit,
+        "mean_specific_energy_measured": (float(np.mean([e["specific_energy"] / share
+                                                         for e in intact])) if intact else None),
+        "mass_relative_error": tally.mass_relative_error})
+    progress(f"{reports.result_line(result)}, {tally.steps} steps, {time.time() - start:.1f} s")
+    return brk, result
+
+
+# -- drop-weight tests ----------------------------------------------------------------------------
+def drop_weight(args):
+    """Every energy, then summary.json and the plot; returns the last energy's controller."""
+    mat, steel = load_material(args.material), load_material("steel")
+    out = Path(args.out)
+    start = time.time()
+
+    def write(results, end_reason, end_message):
+        """summary.json and, if an energy is done, the plot."""
+        write_atomic(out / "summary.json", json.dumps({
+            "material": mat.name, "size": args.size, "results": results,
+            "runtime_s": time.time() - start, "end_reason": end_reason,
+            "end_message": end_message}, indent=2))
+        if results:
+            reports.plot_breakage(results, mat, args.size, steel, f"{mat.name} drop weight",
+                                  out / "drop_weight.png", label="drop weight, simulation")
+
+    def limited(results):
+        at = [r["specific_energy"] for r in results if r["stopped_at_max_time"]]
+        return f"strikers still falling at --max-time at {at} J/kg" if at else ""
+
+    def compute(k, energy):
+        brk, result = _drop_at(args, mat, steel, k, energy, out)
+        progress(f"{reports.result_line(result)}, {time.time() - start:.1f} s")
+        return brk, result
+
+    brk = skeleton.run_units(args, _energies(args), compute, write, limited)
+    progress(f"wrote {out / 'summary.json'} and {out / 'drop_weight.png'}")
+    return brk
+
+
+def _drop_at(args, mat, steel, k, energy, out):
+    """The drop-weight tests at `energy` (J/kg): (controller, the energy's result)."""
+    brk, ids, strikers = scenes.drop_weight_scene(
+        args.material, args.size, energy, args.particles, args.striker_mass_ratio,
+        seed=args.seed + k, time_step_fraction=args.time_step_fraction,
+        read_period=read_period_value(args.read_period),
+        event_log=str(out / f"events_{energy:g}.jsonl"))
+    initial_mass = brk.total_mass()
+    # until every striker rebounds (or max_time of simulated time); then open events close
+    while any(O.bodies[s].state.vel[2] < 0 for s in strikers) and O.time < args.max_time:
+        engine.run_steps(500)
+    stopped = any(O.bodies[s].state.vel[2] < 0 for s in strikers)
+    brk.finish()
+    result = reports.breakage_result(brk, ids, mat, args.size, energy, steel)
+    result["mass_relative_error"] = abs(brk.total_mass() - initial_mass) / initial_mass
+    result["stopped_at_max_time"] = stopped
+    return brk, result
+
+
+# -- repeated impacts -----------------------------------------------------------------------------
+class Repeated(skeleton.Job):
+    """The particles hit the plate again and again at one energy; the broken leave the test. A
+    checkpoint after every impact (the scene, the particles alive and their home positions);
+    --stop-after counts impacts."""
+
+    report_every = math.inf           # a line after every impact instead
+    checkpoint_every = 0.0            # after every impact
+
+    def check(self):
+        args = self.args
+        self.mat = load_material(args.material)
+        if args.gamma > 0:
+            if self.mat.criterion.name != "tavares":
+                raise ScriptError(f"--gamma applies to Tavares materials; {self.mat.name} uses "
+                                  f"{self.mat.criterion.name}")
+            self.mat = dataclasses.replace(self.mat, gamma=args.gamma)
+        self.share = self.mat.energy_partition(load_material(args.target))
+        self.speed = float(np.sqrt(2 * args.energy))
+        self.began = time.time()
+
+    def build(self):
+        args = self.args
+        self.brk, self.ids = scenes.impact_scene(
+            self.mat, args.size, [self.speed] * args.particles, target=args.target,
+            seed=args.seed, replace=False, time_step_fraction=args.time_step_fraction,
+            read_period=read_period_value(args.read_period),
+            event_log=str(self.out / "events.jsonl"))
+        self.home = {i: tuple(O.bodies[i].state.pos) for i in self.ids}
+        self.alive = list(self.ids)
+        self.fractions = []
+
+    def resume(self, path):
+        self.brk, state = skeleton.load_checked(path, engine.load_checkpoint, self.args)
+        self.ids, self.alive, self.fractions = state["ids"], state["alive"], state["fractions"]
+        self.home = {int(i): tuple(p) for i, p in state["home"].items()}
+        self.say(f"resumed from {path} after impact {len(self.fractions)}")
+        return 0.0                    # runtime_s: this invocation's, as it always was
+
+    def advance(self):
+        if len(self.fractions) >= self.args.impacts:
+            return "finished"
+        self.alive = scenes.impact_again(self.brk, self.alive, self.home, self.speed)
+        self.fractions.append(1 - len(self.alive) / self.args.particles)
+        self.say(f"impact {len(self.fractions)}: {100 * self.fractions[-1]:.0f} % broken, "
+                 f"{time.time() - self.began:.1f} s")
+        return None
+
+    def elapsed(self):
+        return len(self.fractions)
+
+    def save(self, path, wall_s):
+        engine.save_checkpoint(path, {
+            "ids": self.ids, "alive": self.alive, "fractions": self.fractions, "home": self.home,
+            "arguments": resume_arguments(self.args)})
+
+    def outputs(self, end_reason, end_message, runtime_s):
+        return _repeated_outputs(self.args, self.mat, self.share, self.fractions, self.brk,
+                                 self.out, runtime_s, end_reason, end_message)
+
+    def finished(self, summary):
+        self.say(f"wrote {self.out / 'summary.json'} and {self.out / 'repeated_impact.png'}")
+
+    def result(self, summary):
+        return getattr(self, "brk", None)
+
+
+def repeated(args):
+    """Every impact, then summary.json and the plot; returns the controller."""
+    return skeleton.run(Repeated(args))
+
+
+def _repeated_outputs(args, mat, share, fractions, brk, out, runtime_s, end_reason, end_message):
+    """summary.json (with how the run ended) and the plot, for the impacts done."""
+    criterion = mat.criterion
+    model_fractions = criterion.repeated_broken_fraction(share * args.energy, args.size,
+                                                         len(fractions))
+    model_label = criterion.repeated_label.format(gamma=mat.gamma)
+    absorbed = [e["specific_energy"] for e in brk.events if e["kind"] == "damage"]
+    summary = {"material": mat.name, "model": mat.breakage_model, "size": args.size,
+               "energy": args.energy, "gamma": mat.gamma,
+               "particles": args.particles, "share_e": share,
+               "broken_fraction": fractions, "model_broken_fraction": model_fractions.tolist(),
+               "mean_absorbed_specific_energy": float(np.mean(absorbed)) if absorbed else None,
+               "expected_absorbed_specific_energy": share * args.energy,
+               "runtime_s": runtime_s, "end_reason": end_reason,
+               "end_message": end_message}
+    write_atomic(out / "summary.json", json.dumps(summary, indent=2))
+
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
+
+    n = np.arange(1, len(fractions) + 1)
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    ax.plot(n, 100 * model_fractions, "k-", label=model_label)
+    sigma = np.sqrt(model_fractions * (1 - model_fractions) / args.particles)
+    ax.errorbar(n, 100 * np.array(fractions),
+                yerr=reports.bounded_errors(100 * np.array(fractions), 300 * sigma, 0.0, 100.0),
+                fmt="o", c="C3", label="simulation (3 sigma of the model)")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))      # impacts are counted
+    ax.set(xlabel="number of impacts", ylabel="broken (%)",
+           title=f"{mat.name}, {1e3 * args.size:g} mm at {args.energy:g} J/kg on {args.target}")
+    ax.legend()
+    fig.tight_layout()
+    save_figure(fig, out / "repeated_impact.png", dpi=110)
+    plt.close(fig)
+    return summary

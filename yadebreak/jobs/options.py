@@ -1,0 +1,298 @@
+"""The options of every job behind scripts/, each declared once, with the checks between options
+that one range cannot say. Pure (imports no yade): the tests read a script's options in-process.
+
+    args = job_options.read("bed_impact", __doc__)        # sys.argv, or a yade-batch row
+
+A bad value stops with one line naming the option, the value, the accepted range and the unit
+(exit code 2), before anything is built or written.
+"""
+import math
+
+from yadebreak.model.intervals import BALL_MASS, PARTICLE_SIZE, elastic_wave_speed
+from yadebreak.options.flags import (break_at_option, checkpointed_run_options, choice, fail,
+                                     flag, integer, jobs_option, material_option, number, numbers,
+                                     out_option, overwrite_option, read_period_option,
+                                     script_params, size_option, text, time_step_option)
+
+
+# -- blocks that several jobs share (besides tools.options' material, size, time step, ...) ----
+def laboratory_test(size, middle, out, resume_help, what):
+    """The options of a laboratory test (single, repeated, drop-weight impacts): the material and
+    size, the job's own `middle` options, the time step, contacts read every step (the exact
+    reference), the output folder, --resume and --stop-after counted in `what` (energies or
+    impacts)."""
+    return [
+        material_option(),
+        size_option(size),
+        *middle,
+        time_step_option(),
+        read_period_option("every_step"),
+        out_option(out),
+        flag("resume", False, resume_help),
+        overwrite_option(),
+        integer("stop_after", 0, f"(tests) end as if killed after this many {what} (0: never)",
+                lo=0, unit=what),
+    ]
+
+
+_KEEPING_ENERGIES = "continue the run in --out, keeping the energies it finished"
+
+
+def _target_option():
+    return text("target", "steel", "the plate: steel, rubber or a material")
+
+
+def _seed_per_energy():
+    return integer("seed", 1, "random seed of the first energy (the next ones: +1, +2, ...)", lo=0)
+
+
+# -- each job's options ----------------------------------------------------------------------------
+def bed_impact():
+    return [
+        material_option("the bed"),
+        size_option(5.5e-3),
+        integer("rings", 3, "hexagonal rings around the central particle", lo=0),
+        integer("layers", 1, "layers of particles (more than one: held by a holder until the "
+                "touch)", lo=1),
+        choice("packing", "auto", ("auto", "poured", "lattice"), "how the bed is built: poured "
+               "into the holder and settled, or hexagonal layers stacked (auto: poured for "
+               "several layers, a lattice for one)"),
+        flag("rolling_friction", True, "apply the material files' rolling friction per contact "
+             "pair (0: none)"),
+        number("steel_rolling_friction", -1.0, "-", "the particle-steel rolling friction instead "
+               "of the material file's (-1: the file's; the paper's Fig. 22 tried 0.33)", lo=-1,
+               hi=10),
+        text("bed_cache", "", "folder of settled poured beds ('': ~/.cache/yadebreak/beds or "
+             "$YADEBREAK_CACHE; off: settle every time)"),
+        number("energy", 3.05, "J", "impact energy of the ball (not per kg)", lo=0, lo_open=True),
+        number("speed", 0.0, "m/s", "the ball's speed instead of --energy (0: from --energy)",
+               lo=0),
+        integer("seed", 1, "random seed", lo=0),
+        time_step_option(),
+        number("dmin", 0.0, "m", "fragments whose progeny would be finer never break "
+               "(0: particle size / 20)", lo=0, hi=PARTICLE_SIZE.hi),
+        number("stiffness_scale", 1.0, "-", "factor on every Young's modulus (a speed knob; the "
+               "paper's is 1)", lo=0, hi=1, lo_open=True),
+        number("global_damping", 0.0, "-", "Newton damping of fresh fragments (0: none)", lo=0,
+               hi=1, hi_open=True),
+        choice("dummies", "ledger", ("ledger", "spheres"), "the unresolved fines: a mass ledger, "
+               "or dummy spheres (the paper)"),
+        number("dummy_stiffness", 1.0, "-", "Young's modulus of the dummy spheres as a share of "
+               "the ore's (with --dummies spheres; the paper allows a softer fines class)",
+               lo=0, hi=1, lo_open=True),
+        read_period_option("fast"),
+        break_at_option(),
+        number("max_time", 0.1, "s", "simulated time at which the run stops at the latest", lo=0,
+               lo_open=True),
+        *checkpointed_run_options(1e-4, "out/bed_impact"),
+    ]
+
+
+def _wave_speed(material):
+    """sqrt(E/rho) of `material` (a name or a file), or None if it does not load (the run reports
+    why, in its own one line)."""
+    from yadebreak.model.materials import MaterialError, load_material
+    try:
+        mat = load_material(material)
+    except (MaterialError, OSError):
+        return None, None
+    return elastic_wave_speed(mat.young_modulus, mat.density), mat.name
+
+
+def check_impact_speed(option, value, speed, material, unit):
+    """Refuse an impact at or above the elastic wave speed of the particles' material, where Hertz
+    contact means nothing: one line naming the option and its largest accepted value (in `unit`,
+    the option's; the value's speed in m/s)."""
+    limit, name = _wave_speed(material)
+    if limit is None or speed < limit:
+        return
+    bound = {"m/s": limit, "J/kg": 0.5 * limit ** 2, "J": 0.5 * BALL_MASS * limit ** 2}[unit]
+    value = f"{value:g}" if isinstance(value, float) else value
+    fail(f"{option} = {value}: must be < {bound:.4g} ({unit}): it means {speed:.4g} m/s, not below "
+         f"the elastic wave speed sqrt(E/rho) of {name}, {limit:.4g} m/s, where Hertz contact "
+         "means nothing")
+
+
+def _check_specific_energies(args, option):
+    """The particles' speed sqrt(2e) at each specific energy of `option` (J/kg) against their
+    material's wave speed."""
+    value = getattr(args, option)
+    energies = [float(e) for e in str(value).split(",")]
+    e = max(energies)
+    check_impact_speed("--" + option.replace("_", "-"), value, math.sqrt(2.0 * e), args.material,
+                       "J/kg")
+
+
+def _check_bed_impact(args):
+    if args.speed > 0:
+        check_impact_speed("--speed", args.speed, args.speed, args.material, "m/s")
+    else:
+        check_impact_speed("--energy", args.energy, math.sqrt(2.0 * args.energy / BALL_MASS),
+                           args.material, "J")
+    if args.dummy_stiffness != 1.0 and args.dummies != "spheres":
+        fail(f"--dummy-stiffness = {args.dummy_stiffness:g}: needs --dummies spheres (the "
+             "ledger keeps no dummy spheres)")
+    if args.packing == "poured" and args.layers < 2:
+        fail(f"--packing = poured: must be with --layers >= 2 (got {args.layers}); a monolayer "
+             "is laid as a lattice")
+
+
+def ball_mill():
+    return [
+        material_option("the ore", "limestone"),  # the softest ore of the library: breaks in 1 s
+        size_option(8e-3),
+        number("ball_size", 25e-3, "m", "diameter of the steel balls", lo=0, lo_open=True,
+               hi=0.5),
+        number("drum_diameter", 0.25, "m", "inside diameter of the drum (to the shell)", lo=0,
+               lo_open=True, hi=10),
+        number("drum_length", 0.1, "m", "length of the drum (the charge scales with it)", lo=0,
+               lo_open=True, hi=10),
+        integer("lifters", 8, "lifter bars along the shell", lo=0, hi=64),
+        number("lifter_height", 10e-3, "m", "height of a lifter bar", lo=0),
+        number("lifter_width", 10e-3, "m", "width of a lifter bar", lo=0, lo_open=True),
+        number("speed", 0.75, "-", "rotation speed as a fraction of the critical speed", lo=0,
+               hi=1, lo_open=True, hi_open=True),
+        number("ball_filling", 0.3, "-", "bulk volume of the balls over the drum's volume", lo=0,
+               hi=0.5, lo_open=True),
+        number("ore_filling", 0.1, "-", "bulk volume of the ore over the drum's volume", lo=0,
+               hi=0.5, lo_open=True),
+        number("duration", 1.0, "s", "simulated time the drum turns", lo=0, lo_open=True),
+        number("stiffness_scale", 1e-3, "-", "factor on every Young's modulus (mill DEM's usual "
+               "reduction, for a longer time step)", lo=0, hi=1, lo_open=True),
+        time_step_option(),
+        number("dmin", 0.0, "m", "smallest resolved fragment; finer progeny goes to the ledger "
+               "(0: --size / 3)", lo=0, hi=PARTICLE_SIZE.hi),
+        read_period_option("fast"),
+        break_at_option(),
+        flag("breakage", True, "0: the spectra run: nothing breaks or is damaged, every stressing "
+             "event of the ore is recorded (spectra.csv, for python3 -m yadebreak grind)"),
+        integer("seed", 1, "random seed", lo=0),
+        number("sample_interval", 0.02, "s", "simulated time between samples of the size "
+               "distribution and the charge", lo=0, lo_open=True),
+        *checkpointed_run_options(0.05, "out/ball_mill"),
+    ]
+
+
+def check_mill_geometry(args):
+    """The mill's cross-checks of its options that one range cannot say: the first that fails, as
+    its one line (the option, its value, the bound and the unit), or None if they hold."""
+    radius = 0.5 * args.drum_diameter
+    if args.ball_size >= radius:
+        return f"--ball-size = {args.ball_size:g}: must be < the drum's radius {radius:g} (m)"
+    if args.lifter_height >= 0.5 * radius:
+        return (f"--lifter-height = {args.lifter_height:g}: must be < half the drum's radius, "
+                f"{0.5 * radius:g} (m)")
+    if args.size >= args.ball_size * 2:
+        return f"--size = {args.size:g}: must be < twice --ball-size, {2 * args.ball_size:g} (m)"
+    return None
+
+
+def _check_ball_mill(args):
+    problem = check_mill_geometry(args)
+    if problem:
+        fail(problem)
+
+
+def agglomerate_impact():
+    return [
+        text("material", "glass_epoxy", "the spheres and binder: a bonded-agglomerate material "
+             "name of the library or a .toml file"),
+        integer("particles", 4104, "primary spheres (the document's 4,104; fewer: a smaller "
+                "agglomerate of the same sizes and packing density)", lo=2, hi=200000),
+        number("speed", 4.0, "m/s", "impact speed, normal to the plane", lo=0, lo_open=True,
+               hi=100),
+        number("duration", 1e-3, "s", "simulated time after the first touch", lo=0,
+               lo_open=True, hi=1.0),
+        number("radius_multiplier", 0.0, "-", "bond radius over the smaller sphere's, lambda "
+               "(0: the material file's)", lo=0, hi=1),
+        number("time_step_fraction", 0.2, "-", "time step as a fraction of the shorter of the "
+               "bonds' time scale and the smallest sphere's Rayleigh time", lo=0, lo_open=True,
+               hi=1),
+        integer("check_period", 1, "steps between two evaluations of the failure criterion over "
+                "the intact bonds (1: every step, exact)", lo=1, hi=100000),
+        number("sample_interval", 5e-6, "s", "simulated time between rows of timeseries.csv",
+               lo=0, lo_open=True),
+        integer("seed", 1, "random seed (packing and bond strengths)", lo=0),
+        *checkpointed_run_options(5e-5, "out/agglomerate_impact"),
+    ]
+
+
+def single_impact():
+    return laboratory_test(5.5e-3, [
+        integer("particles", 250, "particles fired at each energy", lo=1),
+        integer("scene_particles", 1, "particles per scene: independent scenes of at most this "
+                "many, each at the time step of its own finest fragment and ending with its own "
+                "cascade", lo=1),
+        jobs_option("YADE processes sharing the scenes (the results do not depend on it)"),
+        _seed_per_energy(),
+        _target_option(),
+        numbers("energies", "100,200,400", "J/kg", "specific impact energies Ek/mp = v^2/2",
+                lo=0, lo_open=True),
+        flag("replace", True, "replace broken particles by their fragments (0: record events "
+             "only)"),
+    ], "out/single_impact", _KEEPING_ENERGIES, "energies")
+
+
+def repeated_impact():
+    return laboratory_test(37.5e-3, [
+        integer("particles", 100, "particles", lo=1),
+        integer("impacts", 20, "impacts of each particle", lo=1),
+        number("energy", 94.7, "J/kg", "specific impact energy Ek/mp = v^2/2 of every impact",
+               lo=0, lo_open=True),
+        number("gamma", 0.0, "-", "damage exponent of Eq. 5, replacing the material's (0: the "
+               "material's)", lo=0),
+        integer("seed", 1, "random seed", lo=0),
+        _target_option(),
+    ], "out/repeated_impact", "continue the run in --out from the checkpoint after its last "
+       "impact", "impacts")
+
+
+def drop_weight():
+    return laboratory_test(5.5e-3, [
+        integer("particles", 60, "particles tested at each energy", lo=1),
+        _seed_per_energy(),
+        numbers("energies", "150,600", "J/kg", "specific energies of the striker's fall per "
+                "particle mass", lo=0, lo_open=True),
+        number("striker_mass_ratio", 50.0, "-", "striker mass over particle mass", lo=0,
+               lo_open=True),
+        number("max_time", 0.003, "s", "simulated time per energy at the most", lo=0,
+               lo_open=True),
+    ], "out/drop_weight", _KEEPING_ENERGIES, "energies")
+
+
+def extremes():
+    return [
+        out_option("out/extremes"),
+        overwrite_option(),
+        flag("fast", False, "the test suite's particle counts"),
+        text("only", "", "run the cases whose name contains this text ('': all cases)"),
+    ]
+
+
+#: script name -> (its options, the checks between them)
+JOBS = {
+    "bed_impact": (bed_impact, _check_bed_impact),
+    "ball_mill": (ball_mill, _check_ball_mill),
+    "agglomerate_impact": (agglomerate_impact, None),
+    "single_impact": (single_impact, lambda args: _check_specific_energies(args, "energies")),
+    "repeated_impact": (repeated_impact, lambda args: _check_specific_energies(args, "energy")),
+    "drop_weight": (drop_weight, lambda args: _check_specific_energies(args, "energies")),
+    "extremes": (extremes, None),
+}
+
+
+def read(job, description=None, argv=None):
+    """The checked options of `job` (a script's name, a key of JOBS) from `argv` (default
+    sys.argv[1:]) or a yade-batch table row: an argparse.Namespace. A bad value ends the program
+    with its one line (exit code 2)."""
+    declare, check = JOBS[job]
+    args = script_params(declare(), description, argv, table_row=_table_row)
+    if check is not None:
+        check(args)
+    return args
+
+
+def _table_row(defaults):
+    """A yade-batch row's values (yade-batch runs the script inside YADE)."""
+    from yadebreak.adapter.yade_api import table_row
+    return table_row(defaults)

@@ -1,0 +1,152 @@
+"""`python3 -m yadebreak verify [--quick 1]`: the paper's Section 4.1 verification at the paper's
+settings, as a Markdown report with one plot per figure (model lines and simulated points side by
+side, each figure's settings printed under it).
+
+The paper's settings (its Section 3; docs/verification.md): Emax/E50 = 4 in every
+single-particle run; 5 % of the Rayleigh time (RT) for the probabilities, 2 % for the
+fragmentation, 1 % in the cs and damping studies (its Figs. 18-19 captions); dmin = top size / 20, emin = 1e-4 J, kappa = 1, cs = 0;
+global damping from each material file (0.3 copper ore, 0 otherwise); 5.5 mm particles for the
+probabilities, 29 mm for the size distributions and t10.
+
+Figures (--figures, comma-separated):
+  probability  Fig. 8: broken fraction against energy, each material at 5.5 mm, single impacts
+               on steel and drop-weight tests (steel striker and anvil), at the energies where
+               the model gives 10-90 %, with binomial 3 sigma bands.
+  targets      Fig. 9: copper ore at 5.5 mm on steel at two restitutions (the file's 0.39,
+               0.8), on rubber and on a target as stiff as the ore (written to <out>/targets).
+  sizes        Fig. 10: copper ore at 2.8, 5.5, 11 and 22 mm on steel.
+  repeated     Fig. 11: 37.5 mm copper ore at 94.7 J/kg on steel, 10 impacts, gamma 2.5, 5
+               (the file's) and 10; the broken leave the test.
+               In Figs. 8-11 the particles are not replaced (replace=False): the probability is
+               that of the first impact, which replacement cannot change, and the run is
+               10-100x cheaper.
+  progeny      Figs. 13-14: 29 mm copper ore, single impacts at --energies, the progeny as the
+               spheres stand (no fines) and with the fines, against Eq. 10 at Eq. 7's t10.
+  drop_weight  Fig. 15: the same in drop-weight tests (steel striker of 50 particle masses on
+               a steel anvil), each particle its own scene.
+  t10          Fig. 16: t10 against energy for each material at 29 mm (and copper ore at 5.5 mm),
+               single impacts on steel (the paper's Fig. 16 is drop-weight; Fig. 15 runs it).
+  time_step    Fig. 17: 29 mm copper ore at 300 and 3000 J/kg, 1-5 % of the Rayleigh time.
+  cs           Fig. 18: the same with cs 0, 0.5, 1 (1 % RT, no damping; the paper's are drop
+               weight).
+  damping      Fig. 19: the same, single impacts with global damping 0 ... 0.3 (1 % RT).
+               Figures share runs with the same settings (each runs once).
+
+--quick 1: copper ore only, few particles, 2-3 energies (Figs. 9-10: one level, the 50 %; Fig.
+11: 5 impacts, gamma 5 and 10; Figs. 13-19: 2 particles at 1000 J/kg, 2 % RT, 1 in Fig. 15)
+(tests/test_verify.py; 20 s with --jobs 2). The whole command: docs/verification.md (29 minutes
+with --jobs 2 on a quiet 2-core machine).
+Every run is a set of scenes (scenes.run_scenes of an impact_spec or, for the drop weight, a
+drop_weight_spec; Fig. 11: scenes.impact_scene and impact_again, in this process); the results are
+model.reports.breakage_result_of dicts, written to <out>/results.json with their settings. YADE
+runs in this process (the coupling makes it importable); --jobs > 1 runs the scenes in that many
+YADE processes kept for the whole command (scenes.ImpactPool), every figure's runs queued at the
+start, the costliest first.
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from yadebreak.model.materials import MaterialError, load_material
+from yadebreak.jobs.lifecycle import progress, tool_run
+from yadebreak.options.flags import (break_at_option, integer, jobs_option, number, numbers,
+                                     out_option, overwrite_option, text)
+from yadebreak.studies.verify import fragmentation, probability
+from yadebreak.studies.verify.report import write_report
+from yadebreak.studies.verify.settings import (PAPER_MATERIALS, Runner, paper_material, plan,  # noqa: F401
+                       probability_energies)
+
+#: figure name -> the function that runs it and returns its report entry, in report order
+FIGURES = {"probability": probability.figure_probability,
+           "targets": probability.figure_targets, "sizes": probability.figure_sizes,
+           "repeated": probability.figure_repeated,
+           "progeny": fragmentation.figure_progeny,
+           "drop_weight": fragmentation.figure_drop_weight, "t10": fragmentation.figure_t10,
+           "time_step": fragmentation.figure_time_step, "cs": fragmentation.figure_cs,
+           "damping": fragmentation.figure_damping}
+
+#: the figures run unless --figures says otherwise: all
+DEFAULT_FIGURES = list(FIGURES)
+
+PARAMS = [
+    integer("quick", 0, "1: the quick subset (copper ore, few particles, 2-3 energies; under 3 "
+            "minutes)", lo=0, hi=1),
+    text("figures", ",".join(DEFAULT_FIGURES),
+         "figures to run, comma-separated: " + ", ".join(FIGURES), empty=False),
+    text("materials", ",".join(PAPER_MATERIALS), "materials of Figs. 8 and 16 (names or files)",
+         empty=False),
+    numbers("energies", "150,300,1000,3000", "J/kg",
+            "specific energies Ek/mp of Figs. 13-16 (quick: 1000; Figs. 17-19: 300 and 3000)",
+            lo=0, lo_open=True),
+    numbers("dampings", "0,0.1,0.3", "-", "global damping values of Fig. 19 (each < 1)", lo=0),
+    integer("particles", 8, "particles per point in Figs. 13-19 (quick: 2)", lo=1),
+    integer("probability_particles", 250, "particles per point in Figs. 8-11 (the paper's "
+            "250; quick: 40)", lo=1),
+    integer("seed", 3, "seed of every run (scene k of a run: scenes.scene_seed)", lo=0),
+    number("time_step_fraction", 0.0, "-", "overrides every figure's time step (fraction of "
+           "the Rayleigh time); 0: the paper's (5 %, 2 %, 1 %)", lo=0, hi=1),
+    text("read_period", "fast", "how Figs. 13-19 read contacts: fast (the engine's default; "
+         "the same t10 as every_step within 1 %, up to 2.4x faster on limestone's fragment "
+         "clouds: docs/high_energy.md) or every_step (exact); Figs. 8-11 read every step"),
+    number("kappa_successive", 0.0, "-", "Eq. 8's kappa for the fragments' breakage in Figs. "
+           "13-19 (an option beyond the paper; 0: the paper's, the parent's kappa 1)", lo=0),
+    break_at_option(),
+    number("dummy_stiffness", 1.0, "-", "Young's modulus of the dummy spheres in Figs. 13-19 as "
+           "a share of the ore's (an option beyond the paper, which allows a softer dummy class; "
+           "1: the ore's)", lo=0, hi=1, lo_open=True),
+    jobs_option("YADE processes sharing each run's scenes"),
+    out_option("out/verify"),
+    overwrite_option(),
+]
+
+
+def verify(args):
+    """`python3 -m yadebreak verify`: the figures asked for, report.md, results.json, plots."""
+    from yadebreak.options.flags import fail
+    import sys
+    began = time.time()
+    out = Path(args.out)
+    wanted = [f.strip() for f in args.figures.split(",") if f.strip()]
+    unknown = [f for f in wanted if f not in FIGURES]
+    if unknown or not wanted:
+        fail(f"--figures = {args.figures!r}: " + (f"unknown {unknown}" if unknown else
+             "names no figure") + f"; accepted {', '.join(FIGURES)}")
+    args.material_list = (["copper_ore"] if args.quick else
+                          [m.strip() for m in args.materials.split(",") if m.strip()])
+    args.energy_list = [float(e) for e in args.energies.split(",")]
+    args.damping_list = [float(d) for d in args.dampings.split(",")]
+    bad = [d for d in args.damping_list if d >= 1.0]
+    if bad:
+        fail(f"--dampings = {args.dampings}: each global damping must be in [0, 1), got {bad}")
+    if args.read_period not in ("every_step", "fast"):
+        fail(f"--read-period = {args.read_period}: accepted every_step or fast")
+    args.argv = getattr(args, "argv", None) or sys.argv[2:]
+    for name in args.material_list:           # a bad name stops here, before any run
+        try:
+            load_material(name)
+        except MaterialError as exc:
+            if getattr(args, "debug", False):
+                raise
+            fail(f"--materials = {args.materials}: " + "; ".join(exc.problems))
+    with tool_run(out, args):
+        runner = Runner(args.jobs)
+        makers = [make for name, make in FIGURES.items() if name in wanted]
+        try:
+            runner.queue(plan(makers, args, out))     # every figure's runs, the costliest first
+            figures = [make(args, runner, out) for make in makers]
+        finally:
+            runner.close()
+        write_report(out, figures, runner, args, time.time() - began)
+    progress(f"wrote {out / 'report.md'} ({time.time() - began:.0f} s)")
+    return 0
+
+
+def main(argv):
+    """Parse `argv` (after `verify`) and run; bad values stop with one line (exit 2)."""
+    from yadebreak.options.flags import DEBUG, ScriptParser, add_params, read_params
+    parser = ScriptParser(prog="python3 -m yadebreak verify", description=__doc__.split("\n")[0])
+    add_params(parser, PARAMS + [DEBUG])
+    args = read_params(parser.parse_args(argv), PARAMS + [DEBUG])
+    args.argv = list(argv)
+    return verify(args)

@@ -1,0 +1,261 @@
+"""The paper's single-particle settings (its Section 3), one set of impacts (`Run`) and the runner
+that runs each set once however many figures share it."""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import time
+
+import numpy as np
+
+from yadebreak.model.materials import load_material
+from yadebreak.analysis import reports
+from yadebreak.jobs.lifecycle import progress
+
+#: the paper's single-particle verification (its Section 3)
+EMAX_RATIO = 4.0
+PROBABILITY_SIZE = 5.5e-3
+FRAGMENT_SIZE = 29e-3
+RT_PROBABILITY, RT_FRAGMENTATION, RT_DAMPING = 0.05, 0.02, 0.01
+PAPER_MATERIALS = ("copper_ore", "granulite", "limestone")
+#: the model probabilities at which Figs. 8-10 are sampled
+PROBABILITY_LEVELS = (0.1, 0.3, 0.5, 0.7, 0.9)
+QUICK_LEVELS = (0.2, 0.5, 0.8)
+
+@dataclasses.dataclass
+class Run:
+    """One set of impacts: `particles` particles of `material` (name) and `size` (m) at each
+    energy, with attach() options; `test` "single" (fired at the target) or "drop_weight" (a
+    steel striker 50 times the particle's mass falls on it on a steel anvil: the paper's DWT);
+    `per_scene` particles (strikers) side by side in each scene, scene k seeded
+    scenes.scene_seed(seed, k)."""
+
+    material: str
+    size: float
+    energies: list
+    particles: int
+    seed: int
+    options: dict
+    per_scene: int = 1
+    target: str = "steel"
+    test: str = "single"
+
+    def key(self, energy):
+        return json.dumps([self.material, self.size, energy, self.particles, self.seed,
+                           self.target, self.test, sorted(self.options.items())])
+
+
+def paper_material(name):
+    """The material as the paper's single-particle verification ran it (Emax/E50 = 4)."""
+    return dataclasses.replace(load_material(name), emax_ratio=EMAX_RATIO)
+
+
+def probability_energies(material, size, levels, partner):
+    """Specific energies (J/kg, rounded to 2 digits) at which the model's probability is each of
+    `levels`."""
+    grid = np.geomspace(1.0, 1e5, 4000)
+    p = material.breakage_probability(grid, size, partner=partner)
+    return [float(f"{np.interp(level, p, grid):.2g}") for level in levels]
+
+
+def paper_options(time_step, **more):
+    """attach() options of the paper's settings at `time_step` (fraction of the Rayleigh time),
+    contacts read at every step unless `more` says otherwise."""
+    return {"time_step_fraction": time_step, "emax_ratio": EMAX_RATIO, "kappa": 1.0, "cs": 0.0,
+            "emin": 1e-4, "dmin": None, "read_period": "every_step", **more}
+
+
+class Runner:
+    """Runs impacts once per key (figures share runs) and keeps every result. With jobs > 1 the
+    single-impact scenes go to one pool of YADE workers kept for the whole command
+    (scenes.ImpactPool), queued the costliest first: queue() takes every figure's runs at the
+    start (plan() finds them), run_all those of one figure, so that no worker idles while
+    another ends a run. close() stops the pool."""
+
+    def __init__(self, jobs):
+        self.jobs = jobs
+        self.results = {}
+        self._pool = None
+        self._queued = {}                      # run key -> its scenes in the pool
+
+    def run(self, run):
+        return self.run_all([run])[0]
+
+    def run_all(self, runs):
+        """The results of each run (a list per run, one result per energy), run together."""
+        self.queue(runs)
+        each = _each(runs)
+        for key, (run, energy) in each.items():  # jobs 1: here
+            if key not in self._queued and key not in self.results:
+                self._keep(run, energy, _tally_here(run, energy))
+        for key, (run, energy) in each.items():
+            if key in self._queued:
+                self._keep(run, energy, self._pool.collect(self._queued.pop(key),
+                                                           on_wait=_waiting(run, energy)))
+        return [[self.results[run.key(energy)] for energy in run.energies] for run in runs]
+
+    def queue(self, runs):
+        """Send the scenes of `runs` to the pool now (with jobs > 1), the costliest first."""
+        if self.jobs <= 1:
+            return
+        todo = [(key, run, energy) for key, (run, energy) in _each(runs).items()
+                if key not in self.results and key not in self._queued]
+        for key, run, energy in sorted(todo, key=lambda item: -_cost(*item[1:])):
+            self._queued[key] = self._pool_of().submit(_spec(run, energy))
+
+    def close(self):
+        if self._pool is not None:
+            self._pool.close()
+            self._pool = None
+
+    def _pool_of(self):
+        if self._pool is None:
+            from yadebreak import scenes
+            self._pool = scenes.ImpactPool(self.jobs)
+        return self._pool
+
+    def _keep(self, run, energy, tally):
+        mat, steel = paper_material(run.material), load_material(run.target)
+        result = reports.breakage_result_of(tally, mat, energy, steel)
+        if run.options.get("replace") is False:      # no progeny: no t10 to show
+            for name in ("t10_simulated", "t10_primary_events", "progeny_markers",
+                         "relative_sizes", "progeny_passing_simulated",
+                         "progeny_passing_model"):
+                result.pop(name, None)
+            result["t10_note"] = "broken particles not replaced (probability only)"
+        else:
+            result["progeny_passing_resolved"] = reports.resolved_progeny_passing(tally)
+        # wall_s: the scenes' own (worker seconds), whichever process ran them and whatever ran
+        # beside them
+        result.update(steps=tally.steps, scenes_at_step_limit=tally.scenes_at_step_limit,
+                      wall_s=tally.scene_wall_s, material=mat.name, size=run.size,
+                      options=run.options, seed=run.seed, test=run.test)
+        self.results[run.key(energy)] = result
+        progress(f"{mat.name} {1e3 * run.size:g} mm {run.test} "
+                 f"{_settings_short(run.options)}: "
+                 f"{reports.result_line(result)} ({result['wall_s']:.0f} s)")
+
+
+class Planner:
+    """Stands for the Runner in a figure's first lines to learn which runs it asks for (plan):
+    run_all and results stop the figure there."""
+
+    class Asked(Exception):
+        pass
+
+    def __init__(self):
+        self.runs = []
+
+    def run(self, run):
+        return self.run_all([run])
+
+    def run_all(self, runs):
+        self.runs += runs
+        raise Planner.Asked
+
+    @property
+    def results(self):                         # a figure run in this process (Fig. 11)
+        raise Planner.Asked
+
+
+def plan(figures, args, out):
+    """The runs the `figures` (functions of (args, runner, out)) will ask for first."""
+    from yadebreak.studies.verify.report import plt_module
+    planner = Planner()
+    for make in figures:
+        try:
+            make(args, planner, out)
+        except Planner.Asked:
+            pass
+    plt_module().close("all")                  # a figure stopped after its plot was begun
+    return planner.runs
+
+
+def _each(runs):
+    """{key: (run, energy)} of every energy of `runs`, once each."""
+    return {run.key(energy): (run, energy) for run in runs for energy in run.energies}
+
+
+def _cost(run, energy):
+    """A guess of a run's cost, to start the longest first: breakage cascades grow with the
+    energy, the steps with 1 / time step, the shear share adds breakage. Probability runs
+    (nothing replaced) take seconds: they go first, so that their figures come in minutes."""
+    if run.options.get("replace") is False:
+        return math.inf
+    return (energy * run.particles * (1.0 + run.options.get("cs", 0.0))
+            / run.options["time_step_fraction"]
+            * (DROP_WEIGHT_COST if run.test == "drop_weight" else 1.0))
+
+
+#: a drop-weight scene costs about this many single impacts at the same energy and time step
+#: (the striker loads the particle for milliseconds): measured in the whole command, 29 mm copper
+#: ore at 2 % RT and 150-3000 J/kg, one particle per scene: 345 s against 88 s
+DROP_WEIGHT_COST = 4.0
+
+
+def _waiting(run, energy):
+    """A progress line while a run's scenes wait in the pool behind costlier ones."""
+    began = time.time()
+
+    def line(started, submitted):
+        progress(f"waiting for {run.material} {1e3 * run.size:g} mm {energy:g} J/kg: "
+                 f"{started} of {submitted} scenes of the command started "
+                 f"({time.time() - began:.0f} s)")
+    return line
+
+
+#: simulated time after which a drop-weight scene stops even if a striker still falls (s)
+DROP_WEIGHT_MAX_TIME = 0.05
+
+
+def _spec(run, energy):
+    """The run's scenes at `energy` as a spec of scenes.run_scenes (a pool's or this
+    process's)."""
+    from yadebreak import scenes
+    if run.test == "drop_weight":
+        return scenes.drop_weight_spec(run.material, run.size, energy, run.particles,
+                                       run.per_scene, run.seed, DROP_WEIGHT_MAX_TIME,
+                                       **run.options)
+    return scenes.impact_spec(run.material, run.size, float(np.sqrt(2.0 * energy)), run.particles,
+                              run.per_scene, run.seed, target=run.target,
+                              wait_for_arrivals=True, **run.options)
+
+
+def _tally_here(run, energy):
+    """A run's scenes in this process (jobs 1): the same tally as the pool's."""
+    from yadebreak import scenes
+    spec = _spec(run, energy)
+    tally, _ = scenes.run_scenes(spec, range(len(spec["counts"])))
+    return tally
+
+
+def _settings_short(options):
+    gd = options.get("global_damping")
+    return (f"dt {100 * options['time_step_fraction']:g} % RT, global damping "
+            f"{'file' if gd is None else f'{gd:g}'}")
+
+
+def settings_text(options, material_names, size, particles, seed, extra="", damping=None,
+                  target="steel"):
+    """One line of a figure's settings; `damping` (text) replaces the files' global damping;
+    `size` in m or a text (several sizes), `target` the text after "on"."""
+    gd = options.get("global_damping")
+    if damping is None:
+        damping = ("each material file's (" + ", ".join(
+            f"{n} {load_material(n).global_damping:g}" for n in material_names) + ")"
+                   if gd is None else f"{gd:g}")
+    size = size if isinstance(size, str) else f"{1e3 * size:g} mm"
+    return (f"{size} on {target}, {particles} particles per point, seed {seed}; "
+            f"Emax/E50 {EMAX_RATIO:g}, time step {100 * options['time_step_fraction']:g} % of "
+            f"the Rayleigh time, dmin = top size / 20, emin 1e-4 J, kappa 1, "
+            f"cs {options.get('cs', 0.0):g}, global damping {damping}, contacts read "
+            f"{'every step' if options['read_period'] == 'every_step' else 'in fast mode'}"
+            + ("" if options.get("replace", True) else ", broken particles not replaced")
+            + (f"; beyond the paper: kappa {options['kappa_successive']:g} for fragments"
+               if options.get("kappa_successive") else "")
+            + ("; beyond the paper: breakage at the stressing event's peak (t10' of its "
+               "largest energy)" if options.get("break_at") == "peak" else "")
+            + (f"; beyond the paper: dummy spheres {options['dummy_stiffness']:g} times as stiff"
+               if options.get("dummy_stiffness", 1.0) != 1.0 else "")
+            + (f"; {extra}" if extra else ""))
