@@ -14,7 +14,8 @@ ROOT = Path(__file__).resolve().parent.parent
 def _args(out, energy, seed=3, rings=1):
     return argparse.Namespace(material="copper_ore", size=5.5e-3, rings=rings, layers=1,
                               energy=energy, speed=0.0, seed=seed, time_step_fraction=0.05,
-                              dmin=0.0, global_damping=0.0, dummies="ledger", read_period="fast",
+                              dmin=0.0, global_damping="material", dummies="ledger",
+                              read_period="fast",
                               max_time=0.02, out=str(out))
 
 

@@ -29,7 +29,7 @@ def test_options_are_grouped_with_their_defaults():
     (dict(cs=2), "cs = 2: accepted [0, 1]"),
     (dict(read_period=0), "read_period = 0 steps: accepted 'fast', 'every_step', an integer >= 1 "
                           "or 'auto'"),
-    (dict(dmin=0.0), "dmin = 0.0 m: accepted > 0 or None"),
+    (dict(dmin=0.0), "dmin = 0.0 m: accepted (0, 1] or None"),
     (dict(global_damping_time=math.nan), "global_damping_time = nan s: accepted >= 0"),
 ])
 def test_a_bad_option_names_itself_its_value_range_and_unit(option, text):

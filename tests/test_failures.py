@@ -97,7 +97,7 @@ def test_a_warning_is_shown_once_naming_the_scripts_own_option(capsys):
 
 def _bed_args(out, **changes):
     values = dict(material="copper_ore", size=5.5e-3, rings=1, layers=1, energy=0.6, speed=0.0,
-                  seed=3, time_step_fraction=0.05, dmin=0.0, global_damping=0.0,
+                  seed=3, time_step_fraction=0.05, dmin=0.0, global_damping="material",
                   dummies="ledger", read_period="fast", max_time=0.02, out=str(out),
                   checkpoint_every=0.0, vtk_interval=0.0)
     values.update(changes)

@@ -32,7 +32,7 @@ def test_script_help(capsys, job):
     doc = (ROOT / "scripts" / f"{job}.py").read_text().split('"""')[1]
     said = _help(capsys, lambda: job_options.read(job, doc, ["--help"]))
     assert "--out" in said and "--debug" in said, said
-    for p in job_options.JOBS[job][0]():
+    for p in job_options.JOBS[job].params():
         assert p.flag in said
 
 

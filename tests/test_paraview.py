@@ -16,7 +16,7 @@ SPHERE_ARRAYS = {"id": 1, "radius": 1, "velocity": 3, "fracture_energy": 1, "dam
 def _args(out, **changes):
     # 7 particles, 0.9 J: 4 breakages within 1.1 ms of simulated time, about 1.5 s
     values = dict(material="copper_ore", size=5.5e-3, rings=1, layers=1, energy=0.9, speed=0.0,
-                  seed=5, time_step_fraction=0.05, dmin=0.0, global_damping=0.0,
+                  seed=5, time_step_fraction=0.05, dmin=0.0, global_damping="material",
                   dummies="ledger", read_period="fast", max_time=0.02, out=str(out),
                   vtk_interval=INTERVAL)
     values.update(changes)

@@ -57,7 +57,7 @@ def test_the_run_reports_its_bed_and_rolling_friction(scene, tmp_path):
     from yadebreak.jobs import bed
     args = argparse.Namespace(material="copper_ore", size=SIZE, rings=1, layers=3, energy=1.0,
                               speed=0.0, seed=1, time_step_fraction=0.05, dmin=0.0,
-                              global_damping=0.0, dummies="ledger", read_period="fast",
+                              global_damping="material", dummies="ledger", read_period="fast",
                               max_time=0.05, out=str(tmp_path / "run"), packing="auto",
                               rolling_friction=True, steel_rolling_friction=0.33,
                               bed_cache=str(tmp_path / "cache"))
@@ -76,7 +76,7 @@ def _run(tmp_path, name, **kw):
     engine.forget()
     O.reset()
     values = dict(material="copper_ore", size=SIZE, rings=2, layers=1, energy=1.0, speed=0.0,
-                  seed=1, time_step_fraction=0.05, dmin=0.0, global_damping=0.0,
+                  seed=1, time_step_fraction=0.05, dmin=0.0, global_damping="material",
                   dummies="ledger", read_period="fast", max_time=0.05, out=str(tmp_path / name),
                   packing="auto", rolling_friction=True, steel_rolling_friction=-1.0,
                   bed_cache=str(tmp_path / "cache"))

@@ -57,7 +57,7 @@ def _bed_args(out, **changes):
     """A one-ring bed under 0.6 J (3 breakages, 19,400 steps, about 3 s)."""
     import argparse
     values = dict(material="copper_ore", size=5.5e-3, rings=1, layers=1, energy=0.6, speed=0.0,
-                  seed=3, time_step_fraction=0.05, dmin=0.0, global_damping=0.0,
+                  seed=3, time_step_fraction=0.05, dmin=0.0, global_damping="material",
                   dummies="ledger", read_period="fast", max_time=0.02, out=str(out),
                   checkpoint_every=-1.0, vtk_interval=2e-4, resume=False, stop_after=0.0)
     values.update(changes)

@@ -104,19 +104,9 @@ def list_materials(_args):
 
 
 def print_options(_args):
-    """The engine's options as Markdown (docs/options.md is this output)."""
-    from yadebreak.options.table import options_markdown
-    print(OPTIONS_HEADER + options_markdown())
-
-
-OPTIONS_HEADER = """# Options of `yadebreak.attach()`
-
-`attach(materials, seed=0, label="yadebreak", **options)` checks every option against this table
-before anything changes in the scene: a bad value raises `AttachError` naming the option, the
-value, the accepted range and the unit. Written by `python3 -m yadebreak options` from
-`yadebreak/options/table.py` (a test keeps the two the same).
-
-"""
+    """The engine's options and the scripts' overrides as Markdown (docs/options.md)."""
+    from yadebreak.jobs.options import options_page
+    print(options_page(), end="")
 
 
 def sweep(args):

@@ -60,7 +60,8 @@ CASES = {
     "bed_spheres_exact": ("bed_impact", ["--rings", "1", "--energy", "1.0", "--dummies", "spheres",
                                          "--read-period", "1", "--seed", "2"]),
     "bed_auto": ("bed_impact", ["--rings", "2", "--energy", "2.0", "--read-period", "auto",
-                                "--seed", "3", "--global-damping", "0.3"]),
+                                "--seed", "3", "--global-damping", "0.3",
+                                "--global-damping-time", "5e-4"]),
     # in one scene each (--scene-particles), as they were recorded before scenes of a few existed;
     # in this process (--jobs 1): nudged.py nudges the scenes built here, not a pool worker's
     "single_copper": ("single_impact", ["--particles", "20", "--energies", "150,700",

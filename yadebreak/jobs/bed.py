@@ -13,7 +13,7 @@ from yadebreak.scenes import poured_bed
 from yadebreak.adapter.yade_api import O
 from yadebreak.jobs import skeleton
 from yadebreak.jobs.lifecycle import resume_arguments, write_atomic
-from yadebreak.options.flags import read_period_value
+from yadebreak.jobs import options as job_options
 
 FEED_LOWER_SIEVE = 4.75e-3       # m: broken mass is the mass passing the feed's lower sieve
 TAIL = 1e-4                      # s of unloading simulated after the ball's deepest point
@@ -43,20 +43,7 @@ def capture_radius(brk, info):
 
 def _options(args, out):
     """attach() options from the script's arguments."""
-    read_period = read_period_value(args.read_period)
-    options = dict(time_step_fraction=args.time_step_fraction, dummies=args.dummies,
-                   read_period=read_period, event_log=str(out / "events.jsonl"))
-    if args.dmin > 0:
-        options["dmin"] = args.dmin
-    if args.global_damping > 0:
-        options.update(global_damping=args.global_damping, global_damping_time=5e-4)
-    if getattr(args, "break_at", "threshold") != "threshold":
-        options["break_at"] = args.break_at
-    if getattr(args, "dummy_stiffness", 1.0) != 1.0:
-        options["dummy_stiffness"] = args.dummy_stiffness
-    if getattr(args, "stiffness_scale", 1.0) != 1.0:
-        options["stiffness_scale"] = args.stiffness_scale
-    return options
+    return job_options.attach_options("bed_impact", args, event_log=str(out / "events.jsonl"))
 
 
 def _bed_cache(given):
@@ -110,7 +97,8 @@ class BedImpact(skeleton.Job):
             packing=None if getattr(args, "packing", "auto") == "auto" else args.packing,
             rolling=bool(getattr(args, "rolling_friction", True)),
             steel_rolling_friction=None if steel_rolling < 0 else steel_rolling,
-            bed_cache=_bed_cache(getattr(args, "bed_cache", "")), say=self.say,
+            bed_cache=_bed_cache(getattr(args, "bed_cache", "")),
+            stiffness_scale=getattr(args, "stiffness_scale", 1.0), say=self.say,
             **_options(args, self.out))
         mass = self.brk.total_mass()
         self.say(f"{len(self.info['particles'])} particles of {args.material} "

@@ -23,7 +23,7 @@ from yadebreak.model.materials import load_material
 from yadebreak.jobs import skeleton
 from yadebreak.jobs.lifecycle import (ScriptError, progress, resume_arguments, save_figure,
                                        time_left, write_atomic)
-from yadebreak.options.flags import read_period_value
+from yadebreak.jobs import options as job_options
 
 
 def _energies(args):
@@ -80,8 +80,7 @@ def _impacts_at(args, mat, target, k, energy, out, start):
     tally, brk = scenes.single_impacts(
         args.material, args.size, speed, args.particles, args.scene_particles, args.seed + k,
         target=args.target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
-        jobs=args.jobs, replace=args.replace, time_step_fraction=args.time_step_fraction,
-        read_period=read_period_value(args.read_period))
+        jobs=args.jobs, **job_options.attach_options("single_impact", args))
     share = mat.energy_partition(target)
     result = reports.breakage_result_of(tally, mat, energy, target)
     intact = [e for e in tally.first if e["kind"] == "damage"]
@@ -130,9 +129,8 @@ def _drop_at(args, mat, steel, k, energy, out):
     """The drop-weight tests at `energy` (J/kg): (controller, the energy's result)."""
     brk, ids, strikers = scenes.drop_weight_scene(
         args.material, args.size, energy, args.particles, args.striker_mass_ratio,
-        seed=args.seed + k, time_step_fraction=args.time_step_fraction,
-        read_period=read_period_value(args.read_period),
-        event_log=str(out / f"events_{energy:g}.jsonl"))
+        seed=args.seed + k, event_log=str(out / f"events_{energy:g}.jsonl"),
+        **job_options.attach_options("drop_weight", args))
     initial_mass = brk.total_mass()
     # until every striker rebounds (or max_time of simulated time); then open events close
     while any(O.bodies[s].state.vel[2] < 0 for s in strikers) and O.time < args.max_time:
@@ -170,9 +168,8 @@ class Repeated(skeleton.Job):
         args = self.args
         self.brk, self.ids = scenes.impact_scene(
             self.mat, args.size, [self.speed] * args.particles, target=args.target,
-            seed=args.seed, replace=False, time_step_fraction=args.time_step_fraction,
-            read_period=read_period_value(args.read_period),
-            event_log=str(self.out / "events.jsonl"))
+            seed=args.seed, **job_options.attach_options(
+                "repeated_impact", args, event_log=str(self.out / "events.jsonl")))
         self.home = {i: tuple(O.bodies[i].state.pos) for i in self.ids}
         self.alive = list(self.ids)
         self.fractions = []

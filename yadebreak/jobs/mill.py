@@ -22,9 +22,9 @@ from yadebreak.jobs import paraview
 from yadebreak.adapter.yade_api import O, utils, wrapper as _w
 from yadebreak.engine.stepping import smallest_rayleigh_time
 from yadebreak.jobs import skeleton
+from yadebreak.jobs import options as job_options
 from yadebreak.jobs.options import check_mill_geometry
 from yadebreak.jobs.lifecycle import ScriptError, resume_arguments, write_atomic
-from yadebreak.options.flags import read_period_value
 
 PACKING = 0.6                    # solid fraction of a settled charge (bulk volume -> solid volume)
 SETTLE_TIME = 0.25               # s of settling under gravity, drum still, before the engine
@@ -214,14 +214,8 @@ def collision_spectra(events, info, duration):
 
 # -- the run ------------------------------------------------------------------------------------------
 def _options(args, out):
-    read_period = read_period_value(args.read_period)
-    options = dict(time_step_fraction=args.time_step_fraction, dummies="ledger",
-                   read_period=read_period, event_log=str(out / "events.jsonl"),
-                   breakage=bool(getattr(args, "breakage", True)))
-    options["dmin"] = args.dmin if args.dmin > 0 else args.size / 3.0
-    if getattr(args, "break_at", "threshold") != "threshold":
-        options["break_at"] = args.break_at
-    return options
+    """attach() options from the script's arguments."""
+    return job_options.attach_options("ball_mill", args, event_log=str(out / "events.jsonl"))
 
 
 def sieves_for(args):

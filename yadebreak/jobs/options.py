@@ -2,37 +2,72 @@
 that one range cannot say. Pure (imports no yade): the tests read a script's options in-process.
 
     args = job_options.read("bed_impact", __doc__)        # sys.argv, or a yade-batch row
+    options = job_options.attach_options("bed_impact", args, event_log=...)   # for attach()
+
+A job declares its own options (the scene's, the run's) and the attach() options it exposes as
+flags by name: those are made from the option table (yadebreak.options.table) with the table's
+default, unless the job overrides it in its `overrides`, with the reason.
 
 A bad value stops with one line naming the option, the value, the accepted range and the unit
 (exit code 2), before anything is built or written.
 """
 import math
+from dataclasses import dataclass, field
+from typing import Callable
 
 from yadebreak.model.intervals import BALL_MASS, PARTICLE_SIZE, elastic_wave_speed
-from yadebreak.options.flags import (break_at_option, checkpointed_run_options, choice, fail,
-                                     flag, integer, jobs_option, material_option, number, numbers,
-                                     out_option, overwrite_option, read_period_option,
-                                     script_params, size_option, text, time_step_option)
+from yadebreak.options.table import options_markdown
+from yadebreak.options.engine_flags import Derived, Override, attach_options as _attach_options
+from yadebreak.options.engine_flags import OPTION, engine_flag, overrides_markdown
+from yadebreak.options.flags import (checkpointed_run_options, choice, fail, flag, integer,
+                                     jobs_option, material_option, number, numbers, out_option,
+                                     overwrite_option, script_params, size_option, text)
 
 
-# -- blocks that several jobs share (besides tools.options' material, size, time step, ...) ----
-def laboratory_test(size, middle, out, resume_help, what):
-    """The options of a laboratory test (single, repeated, drop-weight impacts): the material and
-    size, the job's own `middle` options, the time step, contacts read every step (the exact
-    reference), the output folder, --resume and --stop-after counted in `what` (energies or
-    impacts)."""
-    return [
-        material_option(),
-        size_option(size),
-        *middle,
-        time_step_option(),
-        read_period_option("every_step"),
-        out_option(out),
-        flag("resume", False, resume_help),
-        overwrite_option(),
-        integer("stop_after", 0, f"(tests) end as if killed after this many {what} (0: never)",
-                lo=0, unit=what),
-    ]
+@dataclass(frozen=True)
+class Job:
+    """A job's options: its own (`own`, then `run`: the output folder, checkpoints, ...), the
+    attach() options it exposes as flags (`engine`, names of the option table), its defaults
+    that differ from the table's (`overrides`, exposed or fixed, each with its reason) and the
+    checks between options (`check`, of the parsed args)."""
+
+    own: Callable
+    engine: tuple = ()
+    overrides: dict = field(default_factory=dict)
+    run: Callable = list
+    check: Callable | None = None
+
+    def params(self):
+        return [*self.own(), *(engine_flag(n, self.overrides) for n in self.engine), *self.run()]
+
+    def attach_options(self, args, **more):
+        """attach()'s options from the parsed `args`, then `more` (the run's own)."""
+        return _attach_options(args, self.engine, self.overrides, **more)
+
+
+# -- blocks that several jobs share (besides flags' material, size, out, ...) ------------------
+#: the laboratory tests read every contact every step
+EXACT_READS = {"read_period": Override(
+    "every_step", "a laboratory test is the reference the paper's figures are checked against: "
+                  "every contact read every step, exact")}
+
+
+def laboratory_test(size, middle, out, resume_help, what, engine=(), overrides=None, check=None):
+    """A laboratory test (single, repeated, drop-weight impacts): the material and size, the
+    job's own `middle` options, the time step and the read period (every step: EXACT_READS)
+    with its `engine` options, the output folder, --resume and --stop-after counted in `what`
+    (energies or impacts)."""
+    return Job(
+        own=lambda: [material_option(), size_option(size), *middle],
+        engine=(*engine, "time_step_fraction", "read_period"),
+        overrides={**EXACT_READS, **(overrides or {})},
+        run=lambda: [
+            out_option(out),
+            flag("resume", False, resume_help),
+            overwrite_option(),
+            integer("stop_after", 0, f"(tests) end as if killed after this many {what} (0: "
+                    "never)", lo=0, unit=what)],
+        check=check)
 
 
 _KEEPING_ENERGIES = "continue the run in --out, keeping the energies it finished"
@@ -47,7 +82,7 @@ def _seed_per_energy():
 
 
 # -- each job's options ----------------------------------------------------------------------------
-def bed_impact():
+def _bed_own():
     return [
         material_option("the bed"),
         size_option(5.5e-3),
@@ -68,24 +103,24 @@ def bed_impact():
         number("speed", 0.0, "m/s", "the ball's speed instead of --energy (0: from --energy)",
                lo=0),
         integer("seed", 1, "random seed", lo=0),
-        time_step_option(),
-        number("dmin", 0.0, "m", "fragments whose progeny would be finer never break "
-               "(0: particle size / 20)", lo=0, hi=PARTICLE_SIZE.hi),
-        number("stiffness_scale", 1.0, "-", "factor on every Young's modulus (a speed knob; the "
-               "paper's is 1)", lo=0, hi=1, lo_open=True),
-        number("global_damping", 0.0, "-", "Newton damping of fresh fragments (0: none)", lo=0,
-               hi=1, hi_open=True),
-        choice("dummies", "ledger", ("ledger", "spheres"), "the unresolved fines: a mass ledger, "
-               "or dummy spheres (the paper)"),
-        number("dummy_stiffness", 1.0, "-", "Young's modulus of the dummy spheres as a share of "
-               "the ore's (with --dummies spheres; the paper allows a softer fines class)",
-               lo=0, hi=1, lo_open=True),
-        read_period_option("fast"),
-        break_at_option(),
+        number("stiffness_scale", 1.0, "-", "factor on every Young's modulus of the scene (a "
+               "speed knob; the paper's is 1)", lo=0, hi=1, lo_open=True),
         number("max_time", 0.1, "s", "simulated time at which the run stops at the latest", lo=0,
                lo_open=True),
-        *checkpointed_run_options(1e-4, "out/bed_impact"),
     ]
+
+
+LEDGER = Override("ledger", "the fines as a mass ledger: the broken mass within the noise of "
+                            "dummy spheres' and the run several times faster "
+                            "(docs/speed_accuracy.md)")
+
+BED_IMPACT = Job(
+    own=_bed_own,
+    engine=("time_step_fraction", "dmin", "global_damping", "global_damping_time", "dummies",
+            "dummy_stiffness", "read_period", "break_at"),
+    overrides={"dummies": LEDGER},
+    run=lambda: checkpointed_run_options(1e-4, "out/bed_impact"),
+    check=lambda args: _check_bed_impact(args))
 
 
 def _wave_speed(material):
@@ -137,7 +172,7 @@ def _check_bed_impact(args):
              "is laid as a lattice")
 
 
-def ball_mill():
+def _ball_mill_own():
     return [
         material_option("the ore", "limestone"),  # the softest ore of the library: breaks in 1 s
         size_option(8e-3),
@@ -159,18 +194,23 @@ def ball_mill():
         number("duration", 1.0, "s", "simulated time the drum turns", lo=0, lo_open=True),
         number("stiffness_scale", 1e-3, "-", "factor on every Young's modulus (mill DEM's usual "
                "reduction, for a longer time step)", lo=0, hi=1, lo_open=True),
-        time_step_option(),
-        number("dmin", 0.0, "m", "smallest resolved fragment; finer progeny goes to the ledger "
-               "(0: --size / 3)", lo=0, hi=PARTICLE_SIZE.hi),
-        read_period_option("fast"),
-        break_at_option(),
-        flag("breakage", True, "0: the spectra run: nothing breaks or is damaged, every stressing "
-             "event of the ore is recorded (spectra.csv, for python3 -m yadebreak grind)"),
         integer("seed", 1, "random seed", lo=0),
         number("sample_interval", 0.02, "s", "simulated time between samples of the size "
                "distribution and the charge", lo=0, lo_open=True),
-        *checkpointed_run_options(0.05, "out/ball_mill"),
     ]
+
+
+BALL_MILL = Job(
+    own=_ball_mill_own,
+    engine=("time_step_fraction", "dmin", "read_period", "break_at", "breakage"),
+    overrides={
+        "dummies": Override("ledger", "thousands of breakages: dummy spheres would multiply the "
+                                      "bodies and shrink the time step"),
+        "dmin": Override(Derived("--size / 3", lambda args: args.size / 3.0),
+                         "fragments resolved down to a third of the feed, finer progeny to the "
+                         "ledger: the bodies and the time step of a mill stay bounded")},
+    run=lambda: checkpointed_run_options(0.05, "out/ball_mill"),
+    check=lambda args: _check_ball_mill(args))
 
 
 def check_mill_geometry(args):
@@ -193,7 +233,7 @@ def _check_ball_mill(args):
         fail(problem)
 
 
-def agglomerate_impact():
+def _agglomerate_own():
     return [
         text("material", "glass_epoxy", "the spheres and binder: a bonded-agglomerate material "
              "name of the library or a .toml file"),
@@ -205,6 +245,7 @@ def agglomerate_impact():
                lo_open=True, hi=1.0),
         number("radius_multiplier", 0.0, "-", "bond radius over the smaller sphere's, lambda "
                "(0: the material file's)", lo=0, hi=1),
+        # the bonded scene's own rule (not attach()'s option of the same name)
         number("time_step_fraction", 0.2, "-", "time step as a fraction of the shorter of the "
                "bonds' time scale and the smallest sphere's Rayleigh time", lo=0, lo_open=True,
                hi=1),
@@ -213,82 +254,123 @@ def agglomerate_impact():
         number("sample_interval", 5e-6, "s", "simulated time between rows of timeseries.csv",
                lo=0, lo_open=True),
         integer("seed", 1, "random seed (packing and bond strengths)", lo=0),
-        *checkpointed_run_options(5e-5, "out/agglomerate_impact"),
     ]
 
 
-def single_impact():
-    return laboratory_test(5.5e-3, [
-        integer("particles", 250, "particles fired at each energy", lo=1),
-        integer("scene_particles", 1, "particles per scene: independent scenes of at most this "
-                "many, each at the time step of its own finest fragment and ending with its own "
-                "cascade", lo=1),
-        jobs_option("YADE processes sharing the scenes (the results do not depend on it)"),
-        _seed_per_energy(),
-        _target_option(),
-        numbers("energies", "100,200,400", "J/kg", "specific impact energies Ek/mp = v^2/2",
-                lo=0, lo_open=True),
-        flag("replace", True, "replace broken particles by their fragments (0: record events "
-             "only)"),
-    ], "out/single_impact", _KEEPING_ENERGIES, "energies")
+AGGLOMERATE_IMPACT = Job(own=_agglomerate_own,
+                         run=lambda: checkpointed_run_options(5e-5, "out/agglomerate_impact"))
 
 
-def repeated_impact():
-    return laboratory_test(37.5e-3, [
-        integer("particles", 100, "particles", lo=1),
-        integer("impacts", 20, "impacts of each particle", lo=1),
-        number("energy", 94.7, "J/kg", "specific impact energy Ek/mp = v^2/2 of every impact",
-               lo=0, lo_open=True),
-        number("gamma", 0.0, "-", "damage exponent of Eq. 5, replacing the material's (0: the "
-               "material's)", lo=0),
-        integer("seed", 1, "random seed", lo=0),
-        _target_option(),
-    ], "out/repeated_impact", "continue the run in --out from the checkpoint after its last "
-       "impact", "impacts")
+SINGLE_IMPACT = laboratory_test(5.5e-3, [
+    integer("particles", 250, "particles fired at each energy", lo=1),
+    integer("scene_particles", 1, "particles per scene: independent scenes of at most this "
+            "many, each at the time step of its own finest fragment and ending with its own "
+            "cascade", lo=1),
+    jobs_option("YADE processes sharing the scenes (the results do not depend on it)"),
+    _seed_per_energy(),
+    _target_option(),
+    numbers("energies", "100,200,400", "J/kg", "specific impact energies Ek/mp = v^2/2",
+            lo=0, lo_open=True),
+], "out/single_impact", _KEEPING_ENERGIES, "energies", engine=("replace",),
+    check=lambda args: _check_specific_energies(args, "energies"))
+
+REPEATED_IMPACT = laboratory_test(37.5e-3, [
+    integer("particles", 100, "particles", lo=1),
+    integer("impacts", 20, "impacts of each particle", lo=1),
+    number("energy", 94.7, "J/kg", "specific impact energy Ek/mp = v^2/2 of every impact",
+           lo=0, lo_open=True),
+    number("gamma", 0.0, "-", "damage exponent of Eq. 5, replacing the material's (0: the "
+           "material's)", lo=0),
+    integer("seed", 1, "random seed", lo=0),
+    _target_option(),
+], "out/repeated_impact", "continue the run in --out from the checkpoint after its last "
+   "impact", "impacts",
+    overrides={"replace": Override(False, "the broken leave the test (the paper's Fig. 11): "
+                                          "their fragments are not followed")},
+    check=lambda args: _check_specific_energies(args, "energy"))
+
+DROP_WEIGHT = laboratory_test(5.5e-3, [
+    integer("particles", 60, "particles tested at each energy", lo=1),
+    _seed_per_energy(),
+    numbers("energies", "150,600", "J/kg", "specific energies of the striker's fall per "
+            "particle mass", lo=0, lo_open=True),
+    number("striker_mass_ratio", 50.0, "-", "striker mass over particle mass", lo=0,
+           lo_open=True),
+    number("max_time", 0.003, "s", "simulated time per energy at the most", lo=0,
+           lo_open=True),
+], "out/drop_weight", _KEEPING_ENERGIES, "energies",
+    check=lambda args: _check_specific_energies(args, "energies"))
+
+EXTREMES = Job(own=lambda: [
+    out_option("out/extremes"),
+    overwrite_option(),
+    flag("fast", False, "the test suite's particle counts"),
+    text("only", "", "run the cases whose name contains this text ('': all cases)"),
+])
 
 
-def drop_weight():
-    return laboratory_test(5.5e-3, [
-        integer("particles", 60, "particles tested at each energy", lo=1),
-        _seed_per_energy(),
-        numbers("energies", "150,600", "J/kg", "specific energies of the striker's fall per "
-                "particle mass", lo=0, lo_open=True),
-        number("striker_mass_ratio", 50.0, "-", "striker mass over particle mass", lo=0,
-               lo_open=True),
-        number("max_time", 0.003, "s", "simulated time per energy at the most", lo=0,
-               lo_open=True),
-    ], "out/drop_weight", _KEEPING_ENERGIES, "energies")
-
-
-def extremes():
-    return [
-        out_option("out/extremes"),
-        overwrite_option(),
-        flag("fast", False, "the test suite's particle counts"),
-        text("only", "", "run the cases whose name contains this text ('': all cases)"),
-    ]
-
-
-#: script name -> (its options, the checks between them)
+#: script name -> its options
 JOBS = {
-    "bed_impact": (bed_impact, _check_bed_impact),
-    "ball_mill": (ball_mill, _check_ball_mill),
-    "agglomerate_impact": (agglomerate_impact, None),
-    "single_impact": (single_impact, lambda args: _check_specific_energies(args, "energies")),
-    "repeated_impact": (repeated_impact, lambda args: _check_specific_energies(args, "energy")),
-    "drop_weight": (drop_weight, lambda args: _check_specific_energies(args, "energies")),
-    "extremes": (extremes, None),
+    "bed_impact": BED_IMPACT,
+    "ball_mill": BALL_MILL,
+    "agglomerate_impact": AGGLOMERATE_IMPACT,
+    "single_impact": SINGLE_IMPACT,
+    "repeated_impact": REPEATED_IMPACT,
+    "drop_weight": DROP_WEIGHT,
+    "extremes": EXTREMES,
 }
+
+
+def attach_options(job, args, **more):
+    """attach()'s options of `job` (a key of JOBS) from its parsed `args`, then `more` (the
+    run's own: event_log, ...): the one translation from flags to engine options."""
+    return JOBS[job].attach_options(args, **more)
+
+
+def arguments_of_today(saved):
+    """A checkpoint's saved arguments as today's flags write them. Before --global-damping-time,
+    the bed's --global-damping 0 meant the material file's damping and a value g > 0 meant g for
+    5e-4 s: they are --global-damping material (forever) and g with --global-damping-time 5e-4."""
+    if "global_damping" in saved and "global_damping_time" not in saved:
+        damping = saved["global_damping"]
+        saved = {**saved, **({"global_damping": OPTION["global_damping"].token,
+                              "global_damping_time": OPTION["global_damping_time"].token}
+                             if damping == 0 else {"global_damping_time": 5e-4})}
+    return saved
+
+
+OPTIONS_PAGE = """# Options of `yadebreak.attach()`
+
+`attach(materials, seed=0, label="yadebreak", **options)` checks every option against this table
+before anything changes in the scene: a bad value raises `AttachError` naming the option, the
+value, the accepted range and the unit. The scripts' flags of these options (`--read-period` for
+`read_period`) are made from the same table, with the same defaults but for the overrides listed
+below; on a command line None is written as the word or number the flag's `--help` names
+(`--global-damping material`, `--dmin 0`). Written by `python3 -m yadebreak options` from
+`yadebreak/options/table.py` and `yadebreak/jobs/options.py` (a test keeps the three the same).
+
+{table}
+
+## The scripts' own defaults
+
+{overrides}
+"""
+
+
+def options_page():
+    """docs/options.md: the option table, then every job's overrides with their reasons."""
+    return OPTIONS_PAGE.format(table=options_markdown(), overrides=overrides_markdown(
+        {job: declared.overrides for job, declared in JOBS.items() if declared.overrides}))
 
 
 def read(job, description=None, argv=None):
     """The checked options of `job` (a script's name, a key of JOBS) from `argv` (default
     sys.argv[1:]) or a yade-batch table row: an argparse.Namespace. A bad value ends the program
     with its one line (exit code 2)."""
-    declare, check = JOBS[job]
-    args = script_params(declare(), description, argv, table_row=_table_row)
-    if check is not None:
-        check(args)
+    declared = JOBS[job]
+    args = script_params(declared.params(), description, argv, table_row=_table_row)
+    if declared.check is not None:
+        declared.check(args)
     return args
 
 

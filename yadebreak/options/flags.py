@@ -70,8 +70,9 @@ class Param:
     hi: float = math.inf
     lo_open: bool = False
     hi_open: bool = False
-    words: tuple = ()          # choice: the accepted words; integer: words accepted besides numbers
+    words: tuple = ()          # choice: the accepted words; integer, number: words besides numbers
     empty: bool = True         # text: '' accepted (False: an output folder, a list to run)
+    why: str = ""              # why the default is this job's (shown after it in --help)
 
     @property
     def flag(self):
@@ -95,6 +96,8 @@ class Param:
             interval = "an integer" + ("" if interval == "any number" else f" {interval}")
             if self.words:
                 interval += ", " + " or ".join(repr(w) for w in self.words)
+        elif self.kind == "number" and self.words:
+            interval += " or " + " or ".join(repr(w) for w in self.words)
         elif self.kind == "numbers":
             interval = f"distinct numbers separated by commas, each {interval}"
         return interval
@@ -117,7 +120,8 @@ class Param:
             parts.append(self.accepted)
         default = int(bool(self.default)) if self.kind == "flag" else self.default
         unit = f" {self.unit}" if self.numeric and self.unit != "-" else ""
-        parts.append(f"default {default}{unit}")
+        unit = "" if default in self.words else unit
+        parts.append(f"default {default}{unit}" + (f" ({self.why})" if self.why else ""))
         return "; ".join(parts).replace("%", "%%")       # argparse %-formats help strings
 
     def _error(self, value, why=""):
@@ -206,6 +210,8 @@ class Param:
                 raise self._error(shown)
             return value
         # number
+        if isinstance(value, str) and value.strip() in self.words:
+            return value.strip()
         plain = isinstance(value, str) and _is_float(value)
         if isinstance(value, str):
             value = self._number(value, shown)
@@ -242,9 +248,11 @@ def _is_float(text):
     return True
 
 
-def number(name, default, unit, help, lo=-math.inf, hi=math.inf, lo_open=False, hi_open=False):
-    """A real number in `unit` (a key of UNITS), in [lo, hi] (open ends as asked)."""
-    return Param(name, default, "number", unit, help, lo, hi, lo_open, hi_open)
+def number(name, default, unit, help, lo=-math.inf, hi=math.inf, lo_open=False, hi_open=False,
+           words=()):
+    """A real number in `unit` (a key of UNITS), in [lo, hi] (open ends as asked), or one of
+    `words`."""
+    return Param(name, default, "number", unit, help, lo, hi, lo_open, hi_open, tuple(words))
 
 
 def integer(name, default, help, lo=-math.inf, hi=math.inf, words=(), unit="-"):
@@ -303,31 +311,6 @@ def size_option(default):
     """--size: within the physical range of particle sizes (intervals.PARTICLE_SIZE), so that the
     time step it sets neither vanishes nor overflows a step count."""
     return number("size", default, "m", "particle size", lo=PARTICLE_SIZE.lo, hi=PARTICLE_SIZE.hi)
-
-
-def read_period_option(default):
-    """--read-period: how often yadebreak reads the contacts (attach()'s read_period)."""
-    return integer("read_period", default, "how often contacts are read: 'fast' (as often as "
-                   "the loading requires), 'every_step' (exact), every k steps or 'auto'",
-                   lo=1, words=("auto", "fast", "every_step"), unit="steps")
-
-
-def read_period_value(value):
-    """attach()'s read_period from --read-period's value (a word, or k as text or a number)."""
-    return value if value in ("auto", "fast", "every_step") else int(value)
-
-
-def break_at_option():
-    """--break-at: when a particle breaks and which energy gives its t10' (attach()'s break_at)."""
-    return choice("break_at", "threshold", ("threshold", "peak"), "when a particle breaks: at "
-                  "the read where its energy first passes its fracture energy (threshold, the "
-                  "paper's) or once its stressing event stops rising, t10' from the event's "
-                  "largest energy (peak)")
-
-
-def time_step_option():
-    return number("time_step_fraction", 0.05, "-", "time step as a fraction of the smallest "
-                  "sphere's Rayleigh time", lo=0, lo_open=True, hi=1)
 
 
 def overwrite_option():

@@ -9,25 +9,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
-from yadebreak.model.intervals import InputError, Interval
+from yadebreak.model.intervals import PARTICLE_SIZE, InputError, Interval
 
 
 class AttachError(InputError, RuntimeError):
     """A scene or an option that yadebreak cannot work with; the message says what to change
     (a RuntimeError too, as it was first)."""
-
-
-@dataclass(frozen=True)
-class Option:
-    """One row of the table: its group, default, accepted values (a check and its text), unit."""
-
-    name: str
-    group: str
-    default: object
-    check: object            # callable(value) -> bool
-    accepted: str
-    unit: str
-    help: str
 
 
 def _number(lo=-math.inf, hi=math.inf, lo_open=False, hi_open=False, none=False):
@@ -56,91 +43,148 @@ def _boolean(v):
     return isinstance(v, bool)
 
 
-def _read_period(v):
-    return v in ("auto", "fast", "every_step") or _count(1)(v)
+@dataclass(frozen=True)
+class Option:
+    """One row of the table: its group, default, kind and accepted values, unit and help.
+
+    kind: "number" (within `interval`), "count" (an integer within `interval`), "choice" (one of
+    `words`), "boolean", "path" or "read_period" (one of `words` or a count within `interval`).
+    `none`: what None means ('' if None is not accepted); `token`: how a command line writes
+    None (a word, or a number outside the range), '' if scripts never pass None."""
+
+    name: str
+    group: str
+    default: object
+    kind: str
+    unit: str
+    help: str
+    interval: Interval = Interval()
+    words: tuple = ()
+    none: str = ""
+    token: object = ""
+
+    def check(self, v):
+        """True if attach() accepts `v` for this option."""
+        if v is None:
+            return bool(self.none)
+        if self.kind == "number":
+            return _number(self.interval.lo, self.interval.hi, self.interval.lo_open,
+                           self.interval.hi_open)(v)
+        if self.kind == "count":
+            return _count(self.interval.lo)(v)
+        if self.kind == "choice":
+            return _one_of(*self.words)(v)
+        if self.kind == "boolean":
+            return _boolean(v)
+        if self.kind == "read_period":
+            return v in self.words or _count(self.interval.lo)(v)
+        return isinstance(v, str)                                   # path
+
+    @property
+    def accepted(self):
+        """The accepted values as attach()'s error and docs/options.md write them."""
+        interval = str(self.interval).removeprefix("in ")
+        text = {"number": interval, "count": f"an integer {interval}",
+                "choice": " or ".join(repr(w) for w in self.words), "boolean": "True or False",
+                "path": "a path"}.get(self.kind)
+        if self.kind == "read_period":
+            first, *more, last = [repr(w) for w in self.words]
+            text = ", ".join([first, *more, f"an integer {interval}"]) + f" or {last}"
+        return text + (" or None" if self.none else "")
+
+    @property
+    def described(self):
+        """The help with what None means (docs/options.md)."""
+        return self.help + (f"; None: {self.none}" if self.none else "")
 
 
-def _path_or_none(v):
-    return v is None or isinstance(v, str)
+def _row(name, group, default, kind, unit, help, lo=-math.inf, hi=math.inf, lo_open=False,
+         hi_open=False, **more):
+    return Option(name, group, default, kind, unit, help, Interval(lo, hi, lo_open, hi_open),
+                  **more)
 
 
 OPTIONS = (
     # reading: the stressing energy taken from the contacts (Eqs. 14-16)
-    Option("cs", "reading", 0.0, _number(0, 1), "[0, 1]", "-",
-           "share of the tangential (shear) work counted in the stressing energy (Eq. 14)"),
-    Option("emin", "reading", 1e-4, _number(0), ">= 0", "J",
-           "a contact's energy counts once it holds at least this much (the paper's Emin)"),
-    Option("read_period", "reading", "fast", _read_period,
-           "'fast', 'every_step', an integer >= 1 or 'auto'", "steps",
-           "how often contacts are read: 'fast' as often as the loading requires; 'every_step' "
-           "every contact every step (the exact reference, the same as 1); every k steps; "
-           "'auto' at read_fraction of the smallest breakable body's Rayleigh time"),
-    Option("read_fraction", "reading", 0.05, _number(0, 1, lo_open=True), "(0, 1]", "-",
-           "'auto': read at this fraction of the Rayleigh time of the smallest breakable body"),
-    Option("fast_fraction", "reading", 0.25, _number(0, 1, lo_open=True), "(0, 1]", "-",
-           "'fast': at least 1/this reads per Hertz loading time of the smallest tracked body "
-           "(breakable, or an unbreakable fragment not yet stressed)"),
-    Option("fast_tolerance", "reading", 0.02, _number(0, 1, lo_open=True), "(0, 1]", "-",
-           "'fast': largest rise of a body's energy between reads, as a fraction of its "
-           "fracture energy (a fresh contact's, at twice the top speed, included)"),
+    _row("cs", "reading", 0.0, "number", "-",
+         "share of the tangential (shear) work counted in the stressing energy (Eq. 14)", 0, 1),
+    _row("emin", "reading", 1e-4, "number", "J",
+         "a contact's energy counts once it holds at least this much (the paper's Emin)", 0),
+    _row("read_period", "reading", "fast", "read_period", "steps",
+         "how often contacts are read: 'fast' as often as the loading requires; 'every_step' "
+         "every contact every step (the exact reference, the same as 1); every k steps; "
+         "'auto' at read_fraction of the smallest breakable body's Rayleigh time", 1,
+         words=("fast", "every_step", "auto")),
+    _row("read_fraction", "reading", 0.05, "number", "-",
+         "'auto': read at this fraction of the Rayleigh time of the smallest breakable body", 0, 1,
+         lo_open=True),
+    _row("fast_fraction", "reading", 0.25, "number", "-",
+         "'fast': at least 1/this reads per Hertz loading time of the smallest tracked body "
+         "(breakable, or an unbreakable fragment not yet stressed)", 0, 1, lo_open=True),
+    _row("fast_tolerance", "reading", 0.02, "number", "-",
+         "'fast': largest rise of a body's energy between reads, as a fraction of its "
+         "fracture energy (a fresh contact's, at twice the top speed, included)", 0, 1,
+         lo_open=True),
     # criteria: overrides of the material files and Rocky's safeguards
-    Option("kappa", "criteria", None, _number(0, lo_open=True, none=True), "> 0 or None", "-",
-           "overrides the material's kappa (Eq. 8); None keeps the file's"),
-    Option("kappa_successive", "criteria", None, _number(0, lo_open=True, none=True),
-           "> 0 or None", "-",
-           "kappa of Eq. 8 for the breakage of fragments (generation >= 1; Tavares materials); "
-           "None: the same as the first breakage's (the paper's)"),
-    Option("break_at", "criteria", "threshold", _one_of("threshold", "peak"),
-           "'threshold' or 'peak'", "-",
-           "when a body breaks and which energy gives its t10' (Eq. 8): 'threshold' at the read "
-           "where its energy first passes its fracture energy (the paper); 'peak' once the "
-           "stressing event stops rising, t10' from the event's largest energy (unbreakable "
-           "fragments likewise record the t10' of the event's peak)"),
-    Option("emax_ratio", "criteria", None, _number(1, lo_open=True, none=True), "> 1 or None", "-",
-           "overrides the material's Emax/E50 (Eq. 2); None keeps the file's"),
-    Option("pause_steps", "criteria", None, _count(0, none=True), "an integer >= 0 or None",
-           "steps", "steps after its creation during which a fragment counts no energy (Rocky's "
-           "safeguard); None: 25 for Ab-T10 materials, 0 for Tavares ones"),
-    Option("breakage", "criteria", True, _boolean, "True or False", "-",
-           "False: nothing breaks or is damaged; every stressing event is recorded (kind "
-           "'stressing', its largest specific energy and partner): a scene's collision spectra"),
-    Option("fragments_energy_factor", "criteria", 1.0, _number(0, 1, lo_open=True), "(0, 1]", "-",
-           "multiplies the specific energy that fragments see (Rocky's safeguard)"),
+    _row("kappa", "criteria", None, "number", "-", "overrides the material's kappa (Eq. 8)", 0,
+         lo_open=True, none="keeps the file's", token=0.0),
+    _row("kappa_successive", "criteria", None, "number", "-",
+         "kappa of Eq. 8 for the breakage of fragments (generation >= 1; Tavares materials)", 0,
+         lo_open=True, none="the same as the first breakage's (the paper's)", token=0.0),
+    _row("break_at", "criteria", "threshold", "choice", "-",
+         "when a body breaks and which energy gives its t10' (Eq. 8): 'threshold' at the read "
+         "where its energy first passes its fracture energy (the paper); 'peak' once the "
+         "stressing event stops rising, t10' from the event's largest energy (unbreakable "
+         "fragments likewise record the t10' of the event's peak)",
+         words=("threshold", "peak")),
+    _row("emax_ratio", "criteria", None, "number", "-", "overrides the material's Emax/E50 "
+         "(Eq. 2)", 1, lo_open=True, none="keeps the file's", token=0.0),
+    _row("pause_steps", "criteria", None, "count", "steps", "steps after its creation during "
+         "which a fragment counts no energy (Rocky's safeguard)", 0,
+         none="25 for Ab-T10 materials, 0 for Tavares ones", token="material"),
+    _row("breakage", "criteria", True, "boolean", "-",
+         "False: nothing breaks or is damaged; every stressing event is recorded (kind "
+         "'stressing', its largest specific energy and partner): a scene's collision spectra"),
+    _row("fragments_energy_factor", "criteria", 1.0, "number", "-",
+         "multiplies the specific energy that fragments see (Rocky's safeguard)", 0, 1,
+         lo_open=True),
     # replacement: what a broken sphere becomes
-    Option("replace", "replacement", True, _boolean, "True or False", "-",
-           "replace broken spheres by their progeny (False: record the event only)"),
-    Option("dmin", "replacement", None, _number(0, lo_open=True, none=True), "> 0 or None", "m",
-           "fragments whose own progeny would be finer than this never break; None: top size / 20"),
-    Option("dummies", "replacement", "spheres", _one_of("spheres", "ledger"),
-           "'spheres' or 'ledger'", "-",
-           "the unresolved fines: dummy spheres in the scene (the paper) or a mass ledger"),
-    Option("dummy_stiffness", "replacement", 1.0, _number(0, 1, lo_open=True), "(0, 1]", "-",
-           "Young's modulus of the dummy spheres as a share of their parent material's (the "
-           "paper: the fines' class may be softer; dummies='spheres'); 1: the parent's"),
-    Option("local_damping", "replacement", 0.0, _number(0, 1), "[0, 1]", "-",
-           "share of a fragment's artificial overlap released as real force"),
-    Option("zero_overlaps", "replacement", True, _boolean, "True or False", "-",
-           "zero the artificial overlaps of fresh fragments (False only to show what it prevents)"),
-    Option("zeroing_tolerance", "replacement", 0.05, _number(0, 1, hi_open=True), "[0, 1)", "-",
-           "a zeroed pair that opens with no force is revisited only when its overlap may have "
-           "shrunk by this share of itself (0: every step)"),
-    Option("family_seed", "replacement", 0, _count(0), "an integer >= 0", "-",
-           "seed of the family tables (not of the run: that is `seed`)"),
+    _row("replace", "replacement", True, "boolean", "-",
+         "replace broken spheres by their progeny (False: record the event only)"),
+    _row("dmin", "replacement", None, "number", "m",
+         "fragments whose own progeny would be finer than this never break", 0,
+         PARTICLE_SIZE.hi, lo_open=True, none="top size / 20", token=0.0),
+    _row("dummies", "replacement", "spheres", "choice", "-",
+         "the unresolved fines: dummy spheres in the scene (the paper) or a mass ledger",
+         words=("spheres", "ledger")),
+    _row("dummy_stiffness", "replacement", 1.0, "number", "-",
+         "Young's modulus of the dummy spheres as a share of their parent material's (the "
+         "paper: the fines' class may be softer; dummies='spheres'); 1: the parent's", 0, 1,
+         lo_open=True),
+    _row("local_damping", "replacement", 0.0, "number", "-",
+         "share of a fragment's artificial overlap released as real force", 0, 1),
+    _row("zero_overlaps", "replacement", True, "boolean", "-",
+         "zero the artificial overlaps of fresh fragments (False only to show what it prevents)"),
+    _row("zeroing_tolerance", "replacement", 0.05, "number", "-",
+         "a zeroed pair that opens with no force is revisited only when its overlap may have "
+         "shrunk by this share of itself (0: every step)", 0, 1, hi_open=True),
+    _row("family_seed", "replacement", 0, "count", "-",
+         "seed of the family tables (not of the run: that is `seed`)", 0),
     # time step and fragment damping
-    Option("time_step_fraction", "time_step", 0.05, _number(0, 1, lo_open=True, none=True),
-           "(0, 1] or None", "-",
-           "O.dt at most this fraction of the smallest sphere's Rayleigh time (a smaller O.dt set "
-           "before attach is kept); None leaves O.dt to the user"),
-    Option("global_damping", "time_step", None, _number(0, 1, hi_open=True, none=True),
-           "[0, 1) or None", "-",
-           "the paper's global damping of fragments: a force against each fragment's motion of "
-           "this share of the force on it (YADE's Newton damping on fragments only; the parent "
-           "never); None: each material file's global_damping (0.3 copper ore, else 0)"),
-    Option("global_damping_time", "time_step", None, _number(0, none=True), ">= 0 or None", "s",
-           "how long fresh fragments stay damped; None: for as long as they exist"),
+    _row("time_step_fraction", "time_step", 0.05, "number", "-",
+         "O.dt at most this fraction of the smallest sphere's Rayleigh time (a smaller O.dt set "
+         "before attach is kept)", 0, 1, lo_open=True, none="leaves O.dt to the user"),
+    _row("global_damping", "time_step", None, "number", "-",
+         "the paper's global damping of fragments: a force against each fragment's motion of "
+         "this share of the force on it (YADE's Newton damping on fragments only; the parent "
+         "never); 0: none", 0, 1, hi_open=True,
+         none="each material file's global_damping (0.3 copper ore, else 0)", token="material"),
+    _row("global_damping_time", "time_step", None, "number", "s",
+         "how long fresh fragments stay damped", 0,
+         none="for as long as they exist", token="forever"),
     # output
-    Option("event_log", "output", None, _path_or_none, "a path or None", "-",
-           "JSON-lines file that receives every event as it happens"),
+    _row("event_log", "output", None, "path", "-",
+         "JSON-lines file that receives every event as it happens", none="no file"),
 )
 
 _BY_NAME = {o.name: o for o in OPTIONS}
@@ -244,5 +288,5 @@ def options_markdown():
     """The options as a Markdown table (README and docs render it from here)."""
     rows = ["| option | default | accepted | unit | what it does |", "|---|---|---|---|---|"]
     for o in OPTIONS:
-        rows.append(f"| `{o.name}` | `{o.default!r}` | {o.accepted} | {o.unit} | {o.help} |")
+        rows.append(f"| `{o.name}` | `{o.default!r}` | {o.accepted} | {o.unit} | {o.described} |")
     return "\n".join(rows)

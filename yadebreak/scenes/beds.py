@@ -44,7 +44,8 @@ POUR_STREAM = 7
 
 def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, energy=3.05,
                      seed=1, settle_steps=3000, packing=None, rolling=True,
-                     steel_rolling_friction=None, bed_cache="", say=lambda m: None, **options):
+                     steel_rolling_friction=None, bed_cache="", stiffness_scale=1.0,
+                     say=lambda m: None, **options):
     """The paper's unconfined bed impact: a 88 mm steel ball on a bed resting on a steel anvil.
 
     The bed: a central particle and `rings` hexagonal rings per layer, `layers` layers. Beds of
@@ -54,8 +55,9 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
     (poured_bed.py; the settled bed comes from the cache `bed_cache` when it was settled before,
     None: no cache); "lattice": the layers stacked in each other's hollows, settled 3000 damped
     steps. Rolling friction (per contact pair, from the material files; the particle-steel value
-    replaced by `steel_rolling_friction` if given) unless rolling=False. The ball starts just
-    above the bed with the speed of its drop, v = sqrt(2 E / m). Returns (controller, info).
+    replaced by `steel_rolling_friction` if given) unless rolling=False. Every Young's modulus of
+    the scene times `stiffness_scale`. The ball starts just above the bed with the speed of its
+    drop, v = sqrt(2 E / m); `options` are attach()'s. Returns (controller, info).
     """
     from yadebreak.scenes import poured_bed
     from yadebreak.engine.scene import YADE_DEFAULT_DT
@@ -64,7 +66,6 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
         raise ValueError(f"packing {packing!r}: 'lattice', or 'poured' for beds of 2 layers or "
                          "more")
     labels = {"ore": material, "steel": "steel"}
-    stiffness_scale = options.pop("stiffness_scale", 1.0)
     overrides = ({} if steel_rolling_friction is None
                  else {("ore", "steel"): float(steel_rolling_friction)})
     lattice = hex_bed_positions(size, rings, layers)

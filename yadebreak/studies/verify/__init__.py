@@ -50,8 +50,9 @@ from pathlib import Path
 
 from yadebreak.model.materials import MaterialError, load_material
 from yadebreak.jobs.lifecycle import progress, tool_run
-from yadebreak.options.flags import (break_at_option, integer, jobs_option, number, numbers,
-                                     out_option, overwrite_option, text)
+from yadebreak.options.engine_flags import Derived, Override, attach_options, engine_flag
+from yadebreak.options.flags import (integer, jobs_option, numbers, out_option, overwrite_option,
+                                     text)
 from yadebreak.studies.verify import fragmentation, probability
 from yadebreak.studies.verify.report import write_report
 from yadebreak.studies.verify.settings import (PAPER_MATERIALS, Runner, paper_material, plan,  # noqa: F401
@@ -69,6 +70,20 @@ FIGURES = {"probability": probability.figure_probability,
 #: the figures run unless --figures says otherwise: all
 DEFAULT_FIGURES = list(FIGURES)
 
+#: attach() options the command exposes for the fragmentation figures (Figs. 13-19), beyond
+#: the paper's settings (studies.verify.settings.PAPER)
+FRAGMENTATION = ("read_period", "kappa_successive", "break_at", "dummy_stiffness")
+#: the command's defaults that differ from attach()'s
+OVERRIDES = {"time_step_fraction": Override(
+    Derived("the paper's per figure: 5 % (Figs. 8-11), 2 % (13-16), 1 % (17-19)", token=0.0),
+    "the paper's Section 3 and the captions of its Figs. 18-19")}
+
+
+def fragmentation_options(args):
+    """attach() options of the fragmentation figures from the command's flags."""
+    return attach_options(args, FRAGMENTATION, {})
+
+
 PARAMS = [
     integer("quick", 0, "1: the quick subset (copper ore, few particles, 2-3 energies; under 3 "
             "minutes)", lo=0, hi=1),
@@ -84,17 +99,8 @@ PARAMS = [
     integer("probability_particles", 250, "particles per point in Figs. 8-11 (the paper's "
             "250; quick: 40)", lo=1),
     integer("seed", 3, "seed of every run (scene k of a run: scenes.scene_seed)", lo=0),
-    number("time_step_fraction", 0.0, "-", "overrides every figure's time step (fraction of "
-           "the Rayleigh time); 0: the paper's (5 %, 2 %, 1 %)", lo=0, hi=1),
-    text("read_period", "fast", "how Figs. 13-19 read contacts: fast (the engine's default; "
-         "the same t10 as every_step within 1 %, up to 2.4x faster on limestone's fragment "
-         "clouds: docs/high_energy.md) or every_step (exact); Figs. 8-11 read every step"),
-    number("kappa_successive", 0.0, "-", "Eq. 8's kappa for the fragments' breakage in Figs. "
-           "13-19 (an option beyond the paper; 0: the paper's, the parent's kappa 1)", lo=0),
-    break_at_option(),
-    number("dummy_stiffness", 1.0, "-", "Young's modulus of the dummy spheres in Figs. 13-19 as "
-           "a share of the ore's (an option beyond the paper, which allows a softer dummy class; "
-           "1: the ore's)", lo=0, hi=1, lo_open=True),
+    *(engine_flag(name, OVERRIDES, "Figs. 13-19: " if name in FRAGMENTATION else "")
+      for name in ("time_step_fraction", *FRAGMENTATION)),
     jobs_option("YADE processes sharing each run's scenes"),
     out_option("out/verify"),
     overwrite_option(),

@@ -32,14 +32,10 @@ FAMILY_FLOOR, DMIN_RELATIVE = float(CLASS_SIZES[-1]), 1.0 / 20.0
 
 
 def _options(args, time_step, **more):
-    """The paper's settings, contacts read as --read-period says (and --kappa-successive,
-    --break-at peak and --dummy-stiffness, options beyond the paper, when given)."""
-    beyond = {"kappa_successive": args.kappa_successive} if args.kappa_successive else {}
-    if args.break_at != "threshold":
-        beyond["break_at"] = args.break_at
-    if args.dummy_stiffness != 1.0:
-        beyond["dummy_stiffness"] = args.dummy_stiffness
-    return paper_options(time_step, read_period=args.read_period, **beyond, **more)
+    """The paper's settings, with --read-period, --kappa-successive, --break-at and
+    --dummy-stiffness (the last three beyond the paper)."""
+    from yadebreak.studies.verify import fragmentation_options
+    return paper_options(time_step, **fragmentation_options(args), **more)
 
 
 def _particles(args):

@@ -12,6 +12,7 @@ import numpy as np
 from yadebreak.model.materials import load_material
 from yadebreak.analysis import reports
 from yadebreak.jobs.lifecycle import progress
+from yadebreak.options.engine_flags import OPTION, Override
 
 #: the paper's single-particle verification (its Section 3)
 EMAX_RATIO = 4.0
@@ -22,6 +23,15 @@ PAPER_MATERIALS = ("copper_ore", "granulite", "limestone")
 #: the model probabilities at which Figs. 8-10 are sampled
 PROBABILITY_LEVELS = (0.1, 0.3, 0.5, 0.7, 0.9)
 QUICK_LEVELS = (0.2, 0.5, 0.8)
+#: the paper's settings that differ from attach()'s defaults (cs, emin and dmin: the table's
+#: defaults are the paper's)
+PAPER = {
+    "emax_ratio": Override(EMAX_RATIO, "the paper's single-particle runs take Emax/E50 = 4"),
+    "kappa": Override(1.0, "the paper's single-particle runs take kappa = 1 (Eq. 8)"),
+    "read_period": Override("every_step", "Figs. 8-11 read every contact every step (exact); "
+                                          "--read-period sets Figs. 13-19's")}
+#: attach()'s defaults that are the paper's settings
+PAPER_DEFAULTS = ("cs", "emin", "dmin")
 
 @dataclasses.dataclass
 class Run:
@@ -62,8 +72,8 @@ def probability_energies(material, size, levels, partner):
 def paper_options(time_step, **more):
     """attach() options of the paper's settings at `time_step` (fraction of the Rayleigh time),
     contacts read at every step unless `more` says otherwise."""
-    return {"time_step_fraction": time_step, "emax_ratio": EMAX_RATIO, "kappa": 1.0, "cs": 0.0,
-            "emin": 1e-4, "dmin": None, "read_period": "every_step", **more}
+    return {"time_step_fraction": time_step, **{k: o.value for k, o in PAPER.items()},
+            **{k: OPTION[k].default for k in PAPER_DEFAULTS}, **more}
 
 
 class Runner:
@@ -248,8 +258,9 @@ def settings_text(options, material_names, size, particles, seed, extra="", damp
     size = size if isinstance(size, str) else f"{1e3 * size:g} mm"
     return (f"{size} on {target}, {particles} particles per point, seed {seed}; "
             f"Emax/E50 {EMAX_RATIO:g}, time step {100 * options['time_step_fraction']:g} % of "
-            f"the Rayleigh time, dmin = top size / 20, emin 1e-4 J, kappa 1, "
-            f"cs {options.get('cs', 0.0):g}, global damping {damping}, contacts read "
+            f"the Rayleigh time, dmin = {OPTION['dmin'].none}, emin {options['emin']:g} J, "
+            f"kappa {options['kappa']:g}, cs {options['cs']:g}, global damping {damping}, "
+            f"contacts read "
             f"{'every step' if options['read_period'] == 'every_step' else 'in fast mode'}"
             + ("" if options.get("replace", True) else ", broken particles not replaced")
             + (f"; beyond the paper: kappa {options['kappa_successive']:g} for fragments"
@@ -257,5 +268,6 @@ def settings_text(options, material_names, size, particles, seed, extra="", damp
             + ("; beyond the paper: breakage at the stressing event's peak (t10' of its "
                "largest energy)" if options.get("break_at") == "peak" else "")
             + (f"; beyond the paper: dummy spheres {options['dummy_stiffness']:g} times as stiff"
-               if options.get("dummy_stiffness", 1.0) != 1.0 else "")
+               if options.get("dummy_stiffness", OPTION["dummy_stiffness"].default)
+               != OPTION["dummy_stiffness"].default else "")
             + (f"; {extra}" if extra else ""))
