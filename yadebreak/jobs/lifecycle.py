@@ -539,18 +539,13 @@ def resume_arguments(args):
                          "vtk_interval", "debug", "jobs")}
 
 
-#: script options added since a checkpoint could have been written, at the value that gives the
-#: behaviour of the scripts before them: a checkpoint without them resumes at that value
-ADDED_OPTIONS = {"break_at": "threshold", "dummy_stiffness": 1.0}
-
-
 def check_resume_arguments(saved, args, path):
     """Refuse to resume, naming the arguments that differ, when `saved` (resume_arguments of the
     interrupted run, stored at `path`) are not this run's (an option added since, at the value
     that was the behaviour then, is not a difference)."""
     from yadebreak.jobs.options import arguments_of_today
     now = resume_arguments(args)
-    saved = {**{k: v for k, v in ADDED_OPTIONS.items() if k in now}, **arguments_of_today(saved)}
+    saved = arguments_of_today(saved, now)
     if saved != now:
         changed = sorted(k for k in set(saved) | set(now) if saved.get(k) != now.get(k))
         raise ScriptError(f"--resume: {path} was written with other values of {changed}; run "

@@ -327,11 +327,19 @@ def attach_options(job, args, **more):
     return JOBS[job].attach_options(args, **more)
 
 
-def arguments_of_today(saved):
-    """A checkpoint's saved arguments as today's flags write them. Before --global-damping-time,
-    the bed's --global-damping 0 meant the material file's damping and a value g > 0 meant g for
-    5e-4 s: they are --global-damping material (forever) and g with --global-damping-time 5e-4."""
-    if "global_damping" in saved and "global_damping_time" not in saved:
+#: script options added since a checkpoint could have been written, at the value that gives the
+#: behaviour of the scripts before them: a checkpoint without them resumes at that value
+ADDED_OPTIONS = {"break_at": "threshold", "dummy_stiffness": 1.0}
+
+
+def arguments_of_today(saved, now):
+    """A checkpoint's saved arguments as today's flags write them, for comparison with the
+    arguments `now` (an option added since, at the value that was the behaviour then, is no
+    difference). Before --global-damping-time, the bed's --global-damping 0 meant the material
+    file's damping and a value g > 0 meant g for 5e-4 s: they are --global-damping material
+    (forever) and g with --global-damping-time 5e-4."""
+    saved = {**{k: v for k, v in ADDED_OPTIONS.items() if k in now}, **saved}
+    if "global_damping" in saved and "global_damping_time" in set(now) - set(saved):
         damping = saved["global_damping"]
         saved = {**saved, **({"global_damping": OPTION["global_damping"].token,
                               "global_damping_time": OPTION["global_damping_time"].token}
