@@ -158,7 +158,7 @@ def end_to_end():
         with tempfile.TemporaryDirectory() as out:
             args = argparse.Namespace(material="copper_ore", size=5.5e-3, rings=3, layers=1,
                                       energy=3.05, speed=0.0, seed=1, time_step_fraction=0.05,
-                                      dmin=0.0, global_damping=0.0, dummies=dummies,
+                                      dmin=0.0, global_damping="material", dummies=dummies,
                                       read_period=read, max_time=0.004 if QUICK else 0.02,
                                       checkpoint_every=-1, out=out)
             _, s = bed.run(args, quiet=True)

@@ -39,15 +39,16 @@ def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False, rolling=None):
 
 
 def impact_scene(material="copper_ore", size=5.5e-3, speeds=(5.0,), target="steel", seed=0,
-                 gap_fraction=0.02, **options):
+                 gap_fraction=0.02, stiffness_scale=1.0, **options):
     """Particles of one size fired normally at a plate (z = 0), one per speed, far apart.
 
     Returns (controller, particle ids). The target is non-breakable even if it is the particle's
-    own material (a separate YADE material with the same properties).
+    own material (a separate YADE material with the same properties). Every Young's modulus of
+    the scene times `stiffness_scale`; `options` are attach()'s.
     """
     O.reset()
     labels = {"particle": material, "target": target}
-    ip2, _ = add_materials(labels, stiffness_scale=options.pop("stiffness_scale", 1.0))
+    ip2, _ = add_materials(labels, stiffness_scale=stiffness_scale)
     O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="target"))
     radius = size / 2.0
     n = len(speeds)
@@ -319,14 +320,14 @@ def _still_striking(i):
 
 
 def drop_weight_scene(material="copper_ore", size=5.5e-3, specific_energy=200.0, particles=50,
-                      striker_mass_ratio=50.0, seed=0, **options):
+                      striker_mass_ratio=50.0, seed=0, stiffness_scale=1.0, **options):
     """Drop-weight tests: a steel striker (a sphere of striker_mass_ratio x the particle's mass)
     falls on each particle resting on a steel anvil, with Ek / mp = specific_energy. The energy
     of both contacts (striker-particle, particle-anvil) is counted (Eq. 14).
     Returns (controller, particle ids, striker ids)."""
     O.reset()
     ip2, mats = add_materials({"particle": material, "steel": "steel"},
-                              stiffness_scale=options.pop("stiffness_scale", 1.0))
+                              stiffness_scale=stiffness_scale)
     O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="steel"))
     radius = size / 2.0
     mat = mats["particle"]
