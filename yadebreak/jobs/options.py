@@ -15,10 +15,11 @@ import math
 from dataclasses import dataclass, field
 from typing import Callable
 
-from yadebreak.model.intervals import BALL_MASS, PARTICLE_SIZE, elastic_wave_speed
+from yadebreak.model.intervals import BALL_MASS, elastic_wave_speed
+from yadebreak.options.engine_flags import (OPTION, Derived, Override, engine_flag,
+                                            overrides_markdown)
+from yadebreak.options.engine_flags import attach_options as _attach_options
 from yadebreak.options.table import options_markdown
-from yadebreak.options.engine_flags import Derived, Override, attach_options as _attach_options
-from yadebreak.options.engine_flags import OPTION, engine_flag, overrides_markdown
 from yadebreak.options.flags import (checkpointed_run_options, choice, fail, flag, integer,
                                      jobs_option, material_option, number, numbers, out_option,
                                      overwrite_option, script_params, size_option, text)

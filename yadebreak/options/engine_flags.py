@@ -16,7 +16,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Callable
 
-from yadebreak.options.flags import Param, choice, flag, integer, number, text
+from yadebreak.options.flags import choice, flag, integer, number, text
 from yadebreak.options.table import OPTIONS
 
 OPTION = {o.name: o for o in OPTIONS}

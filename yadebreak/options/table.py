@@ -1,5 +1,6 @@
-"""The engine's options: one table (name, default, accepted values, unit, help) that validates them
-and renders their documentation, and the frozen groups the parts of the engine read. No yade import.
+"""The engine's options: one table (name, default, accepted values, unit, help, what None means)
+that validates them, renders their documentation and makes the scripts' flags of them
+(engine_flags.py), and the frozen groups the parts of the engine read. No yade import.
 
     config = Config.from_options(seed=1, read_period="fast", dummies="ledger")
     config.reading.read_period, config.replacement.dummies, config.time_step.fraction
