@@ -106,7 +106,9 @@ def list_materials(_args):
 def print_options(_args):
     """The engine's options and the scripts' overrides as Markdown (docs/options.md)."""
     from yadebreak.jobs.options import options_page
-    print(options_page(), end="")
+    from yadebreak.studies import verify
+    from yadebreak.studies.verify.settings import PAPER
+    print(options_page({"verify": {**PAPER, **verify.OVERRIDES}}), end="")
 
 
 def sweep(args):

@@ -356,7 +356,8 @@ value, the accepted range and the unit. The scripts' flags of these options (`--
 `read_period`) are made from the same table, with the same defaults but for the overrides listed
 below; on a command line None is written as the word or number the flag's `--help` names
 (`--global-damping material`, `--dmin 0`). Written by `python3 -m yadebreak options` from
-`yadebreak/options/table.py` and `yadebreak/jobs/options.py` (a test keeps the three the same).
+`yadebreak/options/table.py`, `yadebreak/jobs/options.py` and the verify command's settings
+(`yadebreak/studies/verify`); a test keeps this page the same as its sources.
 
 {table}
 
@@ -366,10 +367,12 @@ below; on a command line None is written as the word or number the flag's `--hel
 """
 
 
-def options_page():
-    """docs/options.md: the option table, then every job's overrides with their reasons."""
-    return OPTIONS_PAGE.format(table=options_markdown(), overrides=overrides_markdown(
-        {job: declared.overrides for job, declared in JOBS.items() if declared.overrides}))
+def options_page(more=None):
+    """docs/options.md: the option table, then every job's overrides with their reasons (and
+    `more`: {command: {option: Override}}, the commands' beyond the scripts)."""
+    jobs = {job: declared.overrides for job, declared in JOBS.items() if declared.overrides}
+    return OPTIONS_PAGE.format(table=options_markdown(),
+                               overrides=overrides_markdown({**jobs, **(more or {})}))
 
 
 def read(job, description=None, argv=None):

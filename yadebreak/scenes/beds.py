@@ -55,10 +55,9 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
     (poured_bed.py; the settled bed comes from the cache `bed_cache` when it was settled before,
     None: no cache); "lattice": the layers stacked in each other's hollows, settled 3000 damped
     steps. Rolling friction (per contact pair, from the material files; the particle-steel value
-    replaced by `steel_rolling_friction` if given) unless rolling=False. Every Young's modulus of
-    the scene times `stiffness_scale`. The ball starts just above the bed with the speed of its
-    drop, v = sqrt(2 E / m); `options` are attach()'s. Returns (controller, info).
-    """
+    replaced by `steel_rolling_friction` if given) unless rolling=False. Moduli x stiffness_scale.
+    The ball starts just above the bed with the speed of its drop, v = sqrt(2 E / m); `options`
+    are attach()'s. Returns (controller, info)."""
     from yadebreak.scenes import poured_bed
     from yadebreak.engine.scene import YADE_DEFAULT_DT
     packing = packing or ("poured" if layers > 1 else "lattice")
