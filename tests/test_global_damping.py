@@ -111,3 +111,23 @@ def test_damped_fragments_are_released_after_the_damping_time(scene):
     fragments = next(e for e in brk.events if e["id"] == ids[0])["fragments"]
     assert O.time > 1e-5
     assert not any(O.bodies[i].state.isDamped for i in fragments if O.bodies[i] is not None)
+
+
+@pytest.mark.yade
+@pytest.mark.parametrize("flags, damping", [([], 0.3), (["--global-damping", "0"], 0.0),
+                                            (["--global-damping", "0.1"], 0.1)])
+def test_the_bed_scripts_flag_switches_damping_off_at_0_and_keeps_the_files_by_default(
+        scene, flags, damping):
+    """--global-damping as bed_impact.py reads it: by default the material file's (0.3 for
+    copper ore), 0 none, a value that value."""
+    from yade import O
+    from yadebreak import engine
+    from yadebreak.jobs import options as job_options
+    args = job_options.read("bed_impact", None, flags)
+    options = job_options.attach_options("bed_impact", args)
+    engine.forget()
+    _, _, newton, _ = _run("copper_ore", 70.0, global_damping=options["global_damping"],
+                           global_damping_time=options["global_damping_time"])
+    assert newton.damping == pytest.approx(damping)
+    engine.forget()
+    O.reset()
