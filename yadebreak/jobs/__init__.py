@@ -14,6 +14,7 @@ impacts      single and repeated impacts, drop-weight tests (scripts/single_impa
 extremes     the stability matrix (scripts/extremes.py)
 paraview     ParaView time series of a running scene
 
-A new job: a skeleton.Job subclass here, its options in job_options.JOBS, and a script of its
-options and one call (scripts/bed_impact.py is one).
+A new job: a skeleton.Job subclass here, its options in job_options.JOBS (a JobOptions: its own,
+the attach() options it exposes, its overrides of their defaults with the reasons), and a script
+of its options and one call (scripts/bed_impact.py is one).
 """

@@ -26,7 +26,7 @@ from yadebreak.options.flags import (checkpointed_run_options, choice, fail, fla
 
 
 @dataclass(frozen=True)
-class Job:
+class JobOptions:
     """A job's options: its own (`own`, then `run`: the output folder, checkpoints, ...), the
     attach() options it exposes as flags (`engine`, names of the option table), its defaults
     that differ from the table's (`overrides`, exposed or fixed, each with its reason) and the
@@ -58,7 +58,7 @@ def laboratory_test(size, middle, out, resume_help, what, engine=(), overrides=N
     job's own `middle` options, the time step and the read period (every step: EXACT_READS)
     with its `engine` options, the output folder, --resume and --stop-after counted in `what`
     (energies or impacts)."""
-    return Job(
+    return JobOptions(
         own=lambda: [material_option(), size_option(size), *middle],
         engine=(*engine, "time_step_fraction", "read_period"),
         overrides={**EXACT_READS, **(overrides or {})},
@@ -115,7 +115,7 @@ LEDGER = Override("ledger", "the fines as a mass ledger: the broken mass within 
                             "dummy spheres' and the run several times faster "
                             "(docs/speed_accuracy.md)")
 
-BED_IMPACT = Job(
+BED_IMPACT = JobOptions(
     own=_bed_own,
     engine=("time_step_fraction", "dmin", "global_damping", "global_damping_time", "dummies",
             "dummy_stiffness", "read_period", "break_at"),
@@ -201,7 +201,7 @@ def _ball_mill_own():
     ]
 
 
-BALL_MILL = Job(
+BALL_MILL = JobOptions(
     own=_ball_mill_own,
     engine=("time_step_fraction", "dmin", "read_period", "break_at", "breakage"),
     overrides={
@@ -258,8 +258,9 @@ def _agglomerate_own():
     ]
 
 
-AGGLOMERATE_IMPACT = Job(own=_agglomerate_own,
-                         run=lambda: checkpointed_run_options(5e-5, "out/agglomerate_impact"))
+AGGLOMERATE_IMPACT = JobOptions(own=_agglomerate_own,
+                                run=lambda: checkpointed_run_options(5e-5,
+                                                                     "out/agglomerate_impact"))
 
 
 SINGLE_IMPACT = laboratory_test(5.5e-3, [
@@ -302,7 +303,7 @@ DROP_WEIGHT = laboratory_test(5.5e-3, [
 ], "out/drop_weight", _KEEPING_ENERGIES, "energies",
     check=lambda args: _check_specific_energies(args, "energies"))
 
-EXTREMES = Job(own=lambda: [
+EXTREMES = JobOptions(own=lambda: [
     out_option("out/extremes"),
     overwrite_option(),
     flag("fast", False, "the test suite's particle counts"),
@@ -310,7 +311,7 @@ EXTREMES = Job(own=lambda: [
 ])
 
 
-#: script name -> its options
+#: script name -> its options (JobOptions)
 JOBS = {
     "bed_impact": BED_IMPACT,
     "ball_mill": BALL_MILL,
