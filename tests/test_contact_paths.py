@@ -23,8 +23,8 @@ def _same_loading(x, y):
 
 def _rows(reader):
     """{(id1, id2): the contact's numbers}"""
-    return {(a, b): tuple(v) for a, b, v in zip(reader.a.tolist(), reader.b.tolist(),
-                                                reader.data.T.tolist())}
+    return {(a, b): tuple(v) for a, b, v in zip(reader.table.a.tolist(), reader.table.b.tolist(),
+                                                reader.table.data.T.tolist())}
 
 
 @pytest.mark.parametrize("cs", [0.0, 0.5])
@@ -46,7 +46,7 @@ def test_both_paths_read_a_breaking_bed_alike(scene, cs):
         O.step()
         for r in (each, full):            # what the engine told its reader since the last step
             r.inherited |= brk.reader.inherited
-            r._erased |= brk.reader._erased
+            r.erased_bodies |= brk.reader.erased_bodies
         for what, pairs in (("zeroed", brk.zeroing.pairs), ("asleep", brk.zeroing.asleep),
                             ("inherited", brk.reader.inherited)):
             seen[what] = max(seen[what], len(pairs))

@@ -182,7 +182,7 @@ def test_a_restored_contact_whose_partner_was_erased_since_is_dropped(scene, tmp
     O.engines = scenes.hertz_engines(ip2)
     brk = engine.attach({"ore": "copper_ore"}, seed=1)
     engine.run_steps(40)
-    assert (1, 2) in zip(brk.reader.a.tolist(), brk.reader.b.tolist())
+    assert (1, 2) in zip(brk.reader.table.a.tolist(), brk.reader.table.b.tolist())
     engine.save(tmp_path / "scene.yade.gz")
     saved_at = O.iter
     O.reset()
@@ -192,5 +192,5 @@ def test_a_restored_contact_whose_partner_was_erased_since_is_dropped(scene, tmp
     restored.reader.small = 0                 # the path that looks the restored rows up
     engine.run_steps(10)
     assert O.iter == saved_at + 10
-    assert all(1 not in pair for pair in zip(restored.reader.a.tolist(),
-                                             restored.reader.b.tolist()))
+    assert all(1 not in pair for pair in zip(restored.reader.table.a.tolist(),
+                                             restored.reader.table.b.tolist()))

@@ -11,7 +11,7 @@ from yadebreak import load_material, model
 from yadebreak.engine import judging
 from yadebreak.options import table as config
 from yadebreak.criteria import engine_side as criteria
-from yadebreak.engine.contacts import ContactReader, Loading
+from yadebreak.engine.contacts import ContactReader, Loading, Strongest
 from yadebreak.engine.state import (BREAKABLE, DUMMY, FORMAT_VERSION, UNBREAKABLE, BodyTable,
                                       EngineState, FinesLedger, check_format)
 
@@ -241,7 +241,8 @@ def _scene(seed):
     for i, load, m in zip(ids.tolist(), loaded, st.table.columns["mass"][ids]):
         if load:
             loading.energy[i] = float(m * rng.uniform(0, 500))
-            loading.strongest[i] = (loading.energy[i], (0.0, 0.0, 1.0), 1.0, int(rng.integers(n)))
+            loading.strongest[i] = Strongest(loading.energy[i], (0.0, 0.0, 1.0), 1.0,
+                                             int(rng.integers(n)))
     return st, [criteria.criterion_for(m) for m in mats], loading
 
 

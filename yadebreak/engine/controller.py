@@ -15,7 +15,7 @@ import numpy as np
 from yadebreak.model import families, placement
 from yadebreak.analysis import reports
 from yadebreak.adapter.yade_api import O, utils
-from yadebreak.engine.contacts import ContactReader
+from yadebreak.engine.contacts import ContactReader, Strongest
 from yadebreak.criteria.engine_side import AbT10, criterion_for
 from yadebreak.engine.judging import Judge
 from yadebreak.engine.replacement import Replacer
@@ -326,10 +326,10 @@ class Controller:
             c["kind"][bid] = BROKEN
             event = {"specific_energy": specific, "fracture_energy": energy, "ratio": ratio,
                      "t10": t10, "generation": int(c["generation"][bid]), "fragments": [],
-                     "partner": -1 if strongest is None else int(strongest[3]), **extra}
+                     "partner": -1 if strongest is None else int(strongest.other), **extra}
             if self.config.replacement.replace:
                 direction = (np.array([0.0, 0.0, 1.0]) if strongest is None
-                             else strongest[2] * np.array(strongest[1]))
+                             else strongest.sign * np.array(strongest.normal))
                 progeny = self.replacer.replace(bid, t10, direction, dmin)
                 self.reader.erased(bid)
                 event.update(fragments=progeny.ids, family_t10=progeny.family_t10,
@@ -351,7 +351,7 @@ class Controller:
             raise ValueError(f"body {body_id} is not a breakable body yadebreak tracks")
         label = self.state.table.label_of(body_id)
         ek = self.criteria[label].force(self.state.table, body_id, ratio)
-        self._break_all([(body_id, ek, (ek, direction, 1.0, -1))])   # no partner: asked for
+        self._break_all([(body_id, ek, Strongest(ek, direction, 1.0, -1))])   # no partner: asked for
         return self.events[-1]
 
     def finish(self):

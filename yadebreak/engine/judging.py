@@ -16,6 +16,7 @@ from itertools import repeat
 import numpy as np
 
 from yadebreak.criteria.engine_side import judge_all
+from yadebreak.engine.contacts import NO_PARTNER
 
 #: up to this many bodies in a read are judged one by one, unless a criterion of the scene says
 #: fewer (its `judged_one_by_one`, where the two paths cost the same)
@@ -26,8 +27,6 @@ NOTHING, FORGET, PAUSE, BREAK, OPEN, CLOSE_IF_UNLOADED = range(6)
 #: the warning that a read came late: a body's criterion variable rose by more than this share of
 #: its fracture energy between two reads, so that its t10' follows the read, not the crossing
 LATE_JUMP = 0.8
-#: loading.strongest of a body whose contacts brought no energy above emin: no partner (-1)
-NO_PARTNER = (0.0, None, 0.0, -1)
 
 
 def steps_allowed(tolerance, threshold, level, rise, interval):
@@ -118,7 +117,7 @@ class Judge:
                 need[k] = BREAK
             elif e > before:
                 c["event_max"][i] = e
-                c["event_partner"][i] = loading.strongest.get(i, NO_PARTNER)[3]
+                c["event_partner"][i] = loading.strongest.get(i, NO_PARTNER).other
                 need[k] = OPEN
             elif before > 0.0:
                 need[k] = CLOSE_IF_UNLOADED
@@ -156,7 +155,7 @@ class Judge:
         grows = active & ~breaks & (ek > event_max)
         c["specific_energy"][ids[active]] = specific[active]
         c["event_max"][ids[grows]] = ek[grows]
-        c["event_partner"][ids[grows]] = [loading.strongest.get(i, NO_PARTNER)[3]
+        c["event_partner"][ids[grows]] = [loading.strongest.get(i, NO_PARTNER).other
                                           for i in ids[grows].tolist()]
         c["event_max"][ids[paused]] = 0.0
         c["specific_energy"][ids[paused]] = 0.0
