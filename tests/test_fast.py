@@ -99,7 +99,7 @@ def test_fast_follows_the_weakest_present_fracture_energy(scene):
     def onset(energy):
         return float(placement.hertz_onset_time(2.75e-3, cu.density, cu.young_modulus,
                                                 cu.poisson_ratio, 1.0, 0.02 * energy))
-    assert brk.reach.get(brk.state.tracked)[0] == pytest.approx(onset(weakened), rel=1e-12)
+    assert brk.tracking.reach.get(brk.state.tracked)[0] == pytest.approx(onset(weakened), rel=1e-12)
     assert onset(weakened) < 0.99 * onset(drawn)           # ~ E^0.4: the two are told apart
 
 

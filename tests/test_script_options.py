@@ -130,7 +130,7 @@ def test_a_tables_unknown_column_is_named_in_one_line(monkeypatch, capsys):
                                                  ("1h", 60.0), ("2 min", 2.0)])
 def test_minutes_take_a_time_unit(text_value, minutes):
     from yadebreak.cli import COMMANDS
-    option = next(p for p in COMMANDS["grind"][2] if p.name == "minutes")
+    option = next(p for p in COMMANDS["grind"].params if p.name == "minutes")
     assert option.convert(text_value) == minutes
     with pytest.raises(ParamError, match=r"--minutes = 5 m: .*\(min\); the unit 'm' is not "):
         option.convert("5 m")

@@ -9,8 +9,10 @@ from __future__ import annotations
 import json
 import sys
 import time
+from collections.abc import Callable
 from contextlib import nullcontext
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -210,19 +212,26 @@ def _grind(args):
         fail(str(exc))
 
 
-#: each command: (function, help, its options[, its positional arguments (name, help)])
+class Command(NamedTuple):
+    """A command of `python3 -m yadebreak` made from the option table's parameters."""
+    run: Callable           # run(args) -> exit code or None
+    help: str
+    params: list            # its options (options.flags parameters)
+    positional: tuple = ()  # its positional arguments: (name, help)
+
+
 COMMANDS = {
-    "demo": (demo, "plot breakage probability and t10 curves of a material", [
+    "demo": Command(demo, "plot breakage probability and t10 curves of a material", [
         text("material", "copper_ore", "a material name or a .toml file"),
         out_option("out/demo"), overwrite_option()]),
-    "families": (plot_families, "plot the family set of a t10' (paper Fig. 2)", [
+    "families": Command(plot_families, "plot the family set of a t10' (paper Fig. 2)", [
         text("material", "table1", "a material name, or table1"),
         number("t10", 3.0, "%", "t10' of the family set", lo=0, lo_open=True, hi=100),
         integer("seed", 0, "seed of the family generation", lo=0),
         out_option("out/families.png", "the plot (PNG)")]),
-    "materials": (list_materials, "list the material library", []),
-    "options": (print_options, "the engine's options as Markdown (docs/options.md)", []),
-    "sweep": (sweep, "run a yade-batch table's lines as Dask tasks, on this machine or a cluster", [
+    "materials": Command(list_materials, "list the material library", []),
+    "options": Command(print_options, "the engine's options as Markdown (docs/options.md)", []),
+    "sweep": Command(sweep, "run a yade-batch table's lines as Dask tasks, on this machine or a cluster", [
         out_option("out/sweep", "folder of the sweep: <out>/<description>/ per line, "
                    "sweep.json, sweep.csv"),
         text("scheduler", "local", "local, local:N (N workers), tcp://HOST:PORT (a running "
@@ -231,11 +240,11 @@ COMMANDS = {
         integer("jobs", 1, "slurm/pbs: batch jobs to start (each one worker)", lo=1),
         text("jobqueue", "", "slurm/pbs: the cluster's options as key=value,... (e.g. "
              "queue=short,walltime=02:00:00,memory=4GB,cores=1)")],
-        [("table", "the yade-batch table"), ("script", "the YADE script each line runs")]),
-    "gather": (gather, "flatten every line's summary.json of a sweep into <out>/sweep.csv", [
+        (("table", "the yade-batch table"), ("script", "the YADE script each line runs"))),
+    "gather": Command(gather, "flatten every line's summary.json of a sweep into <out>/sweep.csv", [
         out_option("out/sweep", "the folder holding <description>/summary.json per line")],
-        [("table", "the yade-batch table")]),
-    "grind": (_grind, "minutes of batch grinding from a mill's collision "
+        (("table", "the yade-batch table"),)),
+    "grind": Command(_grind, "minutes of batch grinding from a mill's collision "
               "spectra (docs/grinding.md)", [
         text("material", "copper_ore", "a material name or a .toml file"),
         text("feed", "5.5", "a single feed size (plain numbers in mm; a length unit may follow: "
@@ -249,8 +258,8 @@ COMMANDS = {
         number("residence", 0.0, "min", "mean residence time of a continuous mill (0: batch)",
                lo=0),
         out_option("out/grind"), overwrite_option()],
-        [("spectra", "a spectra file, a mill run's --out folder (converted) or "
-          "synthetic:BALL_MM (docs/grinding.md)")]),
+        (("spectra", "a spectra file, a mill run's --out folder (converted) or "
+          "synthetic:BALL_MM (docs/grinding.md)"),)),
 }
 
 
@@ -318,13 +327,13 @@ def main(argv=None):
                    "(python -m yadebreak fit --help; docs/calibration.md)")
     sub.add_parser("verify", help="the paper's Section 4.1 figures at its settings, a report "
                    "with plots (python -m yadebreak verify --help; --quick 1: under 3 minutes)")
-    for name, (func, what, params, *positional) in COMMANDS.items():
-        p = sub.add_parser(name, help=what, description=what)
-        for arg, arg_help in (positional[0] if positional else ()):
+    for name, command in COMMANDS.items():
+        p = sub.add_parser(name, help=command.help, description=command.help)
+        for arg, arg_help in command.positional:
             p.add_argument(arg, help=arg_help)
-        add_params(p, params + [DEBUG])
-        p.set_defaults(func=func, params=params + [DEBUG])
-    every = [p for _, _, params, *_ in COMMANDS.values() for p in params]
+        add_params(p, command.params + [DEBUG])
+        p.set_defaults(func=command.run, params=command.params + [DEBUG])
+    every = [p for command in COMMANDS.values() for p in command.params]
     args = parser.parse_args(join_negative_values(argv, every))
     read_params(args, args.params)
     owns_out = any(p.name == "overwrite" for p in args.params)     # a run folder of its own

@@ -7,8 +7,8 @@ ensure_yade_importable()
 import yade.wrapper as wrapper  # noqa: E402
 from yade import O, Vector3, geom, utils  # noqa: E402
 
-__all__ = ["O", "Vector3", "close_remote_access", "current_scene", "find_engine", "geom",
-           "scene_folder", "table_row", "utils", "wrapper"]
+__all__ = ["O", "Vector3", "close_remote_access", "current_scene", "extend_match_makers",
+           "find_engine", "geom", "scene_folder", "table_row", "utils", "wrapper"]
 
 
 def find_engine(label):
@@ -56,3 +56,16 @@ def close_remote_access():
         server.server_close()
         ports.append(server.server_address[1])
     return sorted(ports)
+
+
+def extend_match_makers(loop, more_rows):
+    """Give every MatchMaker of the InteractionLoop's Ip2 functors (per-pair values such as
+    `en`, `es`) the rows `more_rows(rows)` returns for its rows [(id_a, id_b, value)]. YADE's
+    MatchMaker cannot be changed in place: each is replaced by an extended one, through the
+    functor's own attribute."""
+    for functor in loop.physDispatcher.functors:
+        for name, value in functor.dict().items():
+            if isinstance(value, wrapper.MatchMaker):
+                rows = [tuple(m) for m in value.matches]
+                setattr(functor, name, wrapper.MatchMaker(
+                    matches=rows + more_rows(rows), algo=value.algo, val=value.val))

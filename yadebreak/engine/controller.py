@@ -12,16 +12,16 @@ import warnings
 
 import numpy as np
 
-from yadebreak.model import families, placement
+from yadebreak.model import families
 from yadebreak.analysis import reports
 from yadebreak.adapter.yade_api import O, utils
 from yadebreak.engine.contacts import ContactReader, Strongest
 from yadebreak.criteria.engine_side import AbT10, criterion_for
 from yadebreak.engine.judging import Judge
 from yadebreak.engine.replacement import Replacer
-from yadebreak.engine.state import BREAKABLE, BROKEN, UNBREAKABLE, BodyRow, EngineState
-from yadebreak.engine.stepping import (FragmentDamping, Reach, ReadSchedule, SmallestBreakable,
-                                          TimeStep)
+from yadebreak.engine.state import BREAKABLE, BROKEN, UNBREAKABLE, EngineState
+from yadebreak.engine.stepping import FragmentDamping, ReadSchedule, TimeStep
+from yadebreak.engine.tracking import Tracking
 from yadebreak.engine.zeroing import OverlapZeroing
 
 
@@ -77,12 +77,10 @@ class Controller:
                                     config.reading.emin)
         self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero",
                                       config.replacement.zeroing_tolerance)
-        self.smallest = SmallestBreakable()
-        # "fast": the reach of a fresh contact over every tracked body
-        self.reach = Reach(config.reading.fast_tolerance) if config.reading.read_period == "fast" \
-            else None
-        self.schedule = ReadSchedule(config.reading, label, self._smallest_breakable,
-                                     self._reach if self.reach is not None else None)
+        fast = config.reading.read_period == "fast"
+        self.tracking = Tracking(self.state, config.reading.fast_tolerance if fast else None)
+        self.schedule = ReadSchedule(config.reading, label, self.tracking.smallest_breakable,
+                                     self.tracking.reach_now if fast else None)
         self.time_step = TimeStep(config.time_step.time_step_fraction, self._warn_once)
         gd = config.time_step.global_damping        # None: each material file's
         self.damping = FragmentDamping(
@@ -101,11 +99,9 @@ class Controller:
                            any(self.pause_steps.values()), config.reading.fast_tolerance,
                            self._record, self._warn_jump,
                            config.criteria.break_at == "peak")
-        self.judge.weakened = self._weakened
+        self.judge.weakened = self.tracking.weakened
         self.last_iter = -1
         self.wall_time = {"read": 0.0, "replace": 0.0}
-        if self.reach is not None:            # a restored state: its tracked bodies
-            self._reach_rebuild()
 
     # -- what users read ---------------------------------------------------------------------
     @property
@@ -173,77 +169,22 @@ class Controller:
 
     # -- set-up --------------------------------------------------------------------------------
     def register(self, spheres):
-        """Give the breakable spheres found at attach, [(id, label, mass (kg), radius (m))] in id
-        order, their state and fracture energy, drawn per material in id order."""
+        """Give the breakable spheres found at attach (state.Breakable records, in id order)
+        their state and fracture energy, drawn per material in id order."""
         if not spheres:
             return
-        ids = np.array([f[0] for f in spheres])
-        labels = [f[1] for f in spheres]
-        sizes = np.array([2.0 * f[3] for f in spheres])
+        ids = np.array([f.id for f in spheres])
+        labels = [f.label for f in spheres]
+        sizes = np.array([2.0 * f.radius for f in spheres])
         table = self.state.table
         for label in dict.fromkeys(labels):
             idx = np.array([k for k, lab in enumerate(labels) if lab == label])
             energies, extra = self.criteria[label].sample(self.state.rng, sizes[idx])
-            table.add(ids[idx], BREAKABLE, label, [spheres[k][2] for k in idx], sizes[idx] / 2.0,
+            table.add(ids[idx], BREAKABLE, label, [spheres[k].mass for k in idx], sizes[idx] / 2.0,
                       fracture_energy=energies, fracture_energy_initial=energies, **extra)
         table.known = dict.fromkeys(ids.tolist())     # the scene's order (sums follow it)
-        self._adopt(ids.tolist())
+        self.tracking.adopt(ids.tolist())
         self.state.top_size = max(self.state.top_size, float(sizes.max()))
-
-    def _adopt(self, ids):
-        """Track new bodies: breakable and unbreakable ones are read; breakable ones may set the
-        read schedule. Each YADE body gets its row as `body.breakage`."""
-        table = self.state.table
-        kind, radius = table.columns["kind"], table.columns["radius"]
-        for i in ids:
-            k = kind[i]
-            if k == BREAKABLE or k == UNBREAKABLE:
-                self.state.tracked.add(i)
-                if self.reach is not None:
-                    self._reach_add(i)
-            if k == BREAKABLE:
-                self.smallest.push(float(radius[i]), i)
-            O.bodies[i].breakage = BodyRow(table, i)
-
-    def _smallest_breakable(self):
-        return self.smallest.get(self._still_breakable)
-
-    def _reach(self, rebuild):
-        if rebuild:
-            self._reach_rebuild()
-        return self.reach.get(self.state.tracked)
-
-    def _reach_rebuild(self):
-        """The reach of every tracked body from the body table, material by material."""
-        c = self.state.table.columns
-        ids = np.array(sorted(self.state.tracked), np.int64)
-        onset, loading = np.empty(len(ids)), np.empty(len(ids))
-        materials = c["material"][ids]
-        for m in np.unique(materials).tolist():
-            rows = np.flatnonzero(materials == m)
-            mat = O.bodies[int(ids[rows[0]])].material
-            radius = c["radius"][ids[rows]]
-            onset[rows] = placement.hertz_onset_time(
-                radius, mat.density, mat.young, mat.poisson, 1.0,
-                self.reach.tolerance * c["fracture_energy"][ids[rows]])
-            loading[rows] = placement.hertz_loading_time(radius, mat.density, mat.young,
-                                                         mat.poisson, 1.0)
-        self.reach.rebuild(ids.tolist(), onset.tolist(), loading.tolist())
-
-    def _reach_add(self, i):
-        c = self.state.table.columns
-        self.reach.add(i, float(c["radius"][i]), float(c["fracture_energy"][i]),
-                       O.bodies[i].material)
-
-    def _weakened(self, i):
-        """A damage lowered body i's fracture energy: "fast" reads follow it."""
-        if self.reach is not None and i in self.state.tracked:
-            c = self.state.table.columns
-            self.reach.update(i, float(c["radius"][i]), float(c["fracture_energy"][i]),
-                              O.bodies[i].material)
-
-    def _still_breakable(self, i):
-        return i in self.state.tracked and self.state.table.columns["kind"][i] == BREAKABLE
 
     def _warn_once(self, cause, message, remedies=(), purpose=""):
         """A YadebreakWarning, once per cause for this controller (scripts: once per run)."""
@@ -334,7 +275,7 @@ class Controller:
                 self.reader.erased(bid)
                 event.update(fragments=progeny.ids, family_t10=progeny.family_t10,
                              fragment_speed_excess=progeny.speed_excess, **progeny.audit)
-                self._adopt(progeny.ids)
+                self.tracking.adopt(progeny.ids)
                 self.damping.add(progeny.ids)
                 self.schedule.saw_speed(max((O.bodies[i].state.vel.norm() for i in progeny.ids),
                                             default=0.0))

@@ -9,10 +9,11 @@ from collections.abc import Mapping
 from yadebreak import model
 from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS
 from yadebreak.model.materials import Material, MaterialError, load_material
-from yadebreak.adapter.yade_api import O, wrapper
+from yadebreak.adapter.yade_api import O, extend_match_makers, wrapper
 from yadebreak.options.table import AttachError
 from yadebreak.criteria.engine_side import criterion_for
 from yadebreak.engine.parts.rolling import share_pairs as share_rolling_pairs
+from yadebreak.engine.state import Breakable
 
 
 def _frict_material(mat: Material, label: str, stiffness_scale: float = 1.0):
@@ -142,14 +143,9 @@ def _aliased(rows, parent, alias):
 
 
 def _share_pairs(loop, parent, alias):
-    """Each MatchMaker of the loop's Ip2 functors gets `alias` rows copied from `parent`'s (YADE's
-    MatchMaker cannot be changed in place: it is replaced by an extended one)."""
-    for functor in loop.physDispatcher.functors:
-        for name, value in functor.dict().items():
-            if isinstance(value, wrapper.MatchMaker):
-                rows = [tuple(m) for m in value.matches]
-                setattr(functor, name, wrapper.MatchMaker(
-                    matches=rows + _aliased(rows, parent, alias), algo=value.algo, val=value.val))
+    """Each per-pair value of the loop's Ip2 functors (their MatchMakers) gets `alias` rows
+    copied from `parent`'s."""
+    extend_match_makers(loop, lambda rows: _aliased(rows, parent, alias))
 
 
 @dataclasses.dataclass
@@ -206,7 +202,7 @@ def resolve(materials, kappa=None, emax_ratio=None):
 
 
 def breakable_spheres(label_by_id):
-    """[(id, label, mass, radius)] of the scene's bodies with a breakable material (attach only:
+    """state.Breakable records of the scene's bodies with a breakable material (attach only:
     a pass over every body); anything but a loose sphere with such a material is an error."""
     found, problems = [], []
     for b in O.bodies:
@@ -221,7 +217,7 @@ def breakable_spheres(label_by_id):
             problems.append(f"body {b.id} is part of a clump and has the breakable material "
                             f"'{label}': clumps cannot break; use loose spheres")
         else:
-            found.append((b.id, label, b.state.mass, b.shape.radius))
+            found.append(Breakable(b.id, label, b.state.mass, b.shape.radius))
     if problems:
         raise AttachError("; ".join(problems))
     return found

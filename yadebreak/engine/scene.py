@@ -11,7 +11,7 @@ from yadebreak.adapter.yade_api import O, current_scene, find_engine, scene_fold
 from yadebreak.options.table import AttachError, Config
 from yadebreak.engine.controller import Controller
 from yadebreak.engine.materials import breakable_spheres, check_mapping, dummy_materials, resolve
-from yadebreak.engine.state import BREAKABLE, BodyRow, EngineState, EventLog
+from yadebreak.engine.state import EngineState, EventLog
 from yadebreak.engine.stepping import smallest_rayleigh_time
 
 _ENGINES: dict[str, Controller] = {}
@@ -199,9 +199,6 @@ def _restore(label):
                               config.criteria.emax_ratio)
     state = EngineState.from_dict(data["state"], config.output.event_log)
     ctl = Controller(label, config, scene_materials, data["materials"], state)
-    table = state.table
-    ctl.smallest.rebuild((float(table.columns["radius"][i]), i) for i in state.tracked
-                         if table.columns["kind"][i] == BREAKABLE)
     engine = find_engine(label)
     ctl.schedule.period = engine.iterPeriod if engine is not None else 1
     ctl.schedule.restore(data["fast"])
@@ -209,10 +206,6 @@ def _restore(label):
     ctl.zeroing.restore(data["zeroed"])
     ctl.damping.until = [tuple(x) for x in data["damped_until"]]
     ctl.last_iter = data.get("last_read", data["iter"] - 1)   # the steps since it: the next read's
-    for bid in table:
-        b = O.bodies[bid] if bid < len(O.bodies) else None
-        if b is not None:
-            b.breakage = BodyRow(table, bid)
     state.log.rewrite()                    # the log holds exactly the events of this state
     return ctl
 

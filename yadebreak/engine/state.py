@@ -13,6 +13,7 @@ import json
 import math
 import os
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -21,6 +22,14 @@ FORMAT_VERSION = 2
 
 KINDS = ("none", "breakable", "unbreakable", "dummy", "broken")
 NONE, BREAKABLE, UNBREAKABLE, DUMMY, BROKEN = range(5)
+
+
+class Breakable(NamedTuple):
+    """A breakable sphere found in the scene at attach."""
+    id: int
+    label: str            # its YADE material's label
+    mass: float           # kg
+    radius: float         # m
 
 #: column -> (dtype, value of a new row); energies J/kg, event_max J, sizes m, mass kg
 _COLUMNS = {
