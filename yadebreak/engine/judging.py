@@ -15,7 +15,7 @@ from itertools import repeat
 
 import numpy as np
 
-from yadebreak.criteria.engine_side import judge_all
+from yadebreak.criteria import judge_all
 
 #: up to this many bodies in a read are judged one by one, unless a criterion of the scene says
 #: fewer (its `judged_one_by_one`, where the two paths cost the same)
