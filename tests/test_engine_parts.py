@@ -10,7 +10,7 @@ import pytest
 from yadebreak import load_material, model
 from yadebreak.engine import judging
 from yadebreak.options import table as config
-from yadebreak.criteria import engine_side as criteria
+from yadebreak import criteria
 from yadebreak.engine.contacts import ContactReader, Loading, Strongest
 from yadebreak.engine.state import (BREAKABLE, DUMMY, FORMAT_VERSION, UNBREAKABLE, BodyTable,
                                       EngineState, FinesLedger, check_format)

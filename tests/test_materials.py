@@ -183,16 +183,17 @@ def test_sampling_uses_the_generator(tmp_path):
     np.testing.assert_array_equal(a, b)
 
 
-def test_the_criterion_is_chosen_once_by_the_material_and_the_coupling_follows_it():
-    """The material's file names its criterion (Material.criterion, from one registry); YADE's
-    side of each criterion is picked by the same name."""
-    from yadebreak.criteria import engine_side as criteria
+def test_the_criterion_is_chosen_once_by_the_material_and_the_engine_uses_it():
+    """The material's file names its criterion (Material.criterion, from the one registry); the
+    engine's criterion_for gives that same object."""
+    from yadebreak import criteria
     from yadebreak.model.materials import CRITERIA
-    assert set(CRITERIA) == set(criteria._CRITERIA)
+    assert CRITERIA == {"tavares": criteria.Tavares, "ab_t10": criteria.AbT10}
     for name in available_materials():
         mat = load_material(name)
         assert mat.criterion.name == (mat.breakage_model or "tavares")
         assert mat.is_ab_t10 == (mat.criterion.name == "ab_t10")
         if mat.breakable:
-            assert type(criteria.criterion_for(mat)) is criteria._CRITERIA[mat.criterion.name]
+            assert criteria.criterion_for(mat) is mat.criterion
+            assert type(mat.criterion) is criteria.criterion_class(mat.criterion.name)
             assert mat.t10_ceiling == (mat.t10_max if mat.is_ab_t10 else mat.A)

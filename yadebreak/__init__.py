@@ -21,6 +21,7 @@ from importlib import import_module
 from yadebreak.model.materials import (Material, MaterialError, available_materials,
                                        load_material, material_search_path)
 from yadebreak import model
+from yadebreak import criteria  # registers the criteria in model.materials.CRITERIA
 from yadebreak._moved import install as _install_moved
 
 _install_moved()
@@ -28,7 +29,7 @@ _install_moved()
 __version__ = "0.3.0"
 
 __all__ = ["Material", "MaterialError", "available_materials", "load_material",
-           "material_search_path", "model", "attach", "save"]
+           "material_search_path", "model", "criteria", "attach", "save"]
 
 # where the modules of version 0.2 went: `from yadebreak import families` keeps working
 _MOVED = {"materials": "model.materials", "families": "model.families",

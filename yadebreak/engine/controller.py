@@ -16,7 +16,7 @@ from yadebreak.model import families
 from yadebreak.analysis import reports
 from yadebreak.adapter.yade_api import O, utils
 from yadebreak.engine.contacts import ContactReader, Strongest
-from yadebreak.criteria.engine_side import AbT10, criterion_for
+from yadebreak.criteria import criterion_for
 from yadebreak.engine.judging import Judge
 from yadebreak.engine.replacement import Replacer
 from yadebreak.engine.state import BREAKABLE, BROKEN, UNBREAKABLE, EngineState
@@ -223,11 +223,7 @@ class Controller:
         table = self.state.table
         crit = self.criteria[table.label_of(bid)]
         ratio, t10, _ = crit.breakage(table, bid, ek)
-        if isinstance(getattr(crit, "inner", crit), AbT10):
-            low = float(crit.material.t10_of_cumulative_energy(
-                scale, 2.0 * float(table.columns["radius"][bid])))
-        else:
-            low = crit.breakage(table, bid, scale * float(table.columns["mass"][bid]))[1]
+        low = crit.t10_at_threshold(table, bid, scale)
         self._warn_once("jump", (
             f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
             f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s): "

@@ -15,7 +15,7 @@ from itertools import repeat
 
 import numpy as np
 
-from yadebreak.criteria.engine_side import judge_all
+from yadebreak.criteria import judge_all
 from yadebreak.engine.contacts import NO_PARTNER
 
 #: up to this many bodies in a read are judged one by one, unless a criterion of the scene says

@@ -11,7 +11,7 @@ from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS
 from yadebreak.model.materials import Material, MaterialError, load_material
 from yadebreak.adapter.yade_api import O, extend_match_makers, wrapper
 from yadebreak.options.table import AttachError
-from yadebreak.criteria.engine_side import criterion_for
+from yadebreak.criteria import criterion_for
 from yadebreak.engine.parts.rolling import share_pairs as share_rolling_pairs
 from yadebreak.engine.state import Breakable
 

@@ -2,10 +2,7 @@
 the event log and the fines ledger, with to_dict / from_dict for saving with the scene. No yade
 import.
 
-Classes of a body (`kind`, also the codes of the `class` column of outputs):
-breakable (1) can break; unbreakable (2) is finer than dmin allows to break again and keeps the
-t10' of its first would-be breakage; dummy (3) stands for the unresolved fines of an event and never
-breaks; broken (4) was replaced. 0 marks ids yadebreak does not know.
+Classes of a body (`kind`): model/kinds.py, shared with the criteria.
 """
 from __future__ import annotations
 
@@ -17,11 +14,10 @@ from typing import NamedTuple
 
 import numpy as np
 
+from yadebreak.model.kinds import BREAKABLE, BROKEN, DUMMY, KINDS, NONE, UNBREAKABLE  # noqa: F401
+
 #: format of to_dict(); from_dict refuses others with a clear message
 FORMAT_VERSION = 2
-
-KINDS = ("none", "breakable", "unbreakable", "dummy", "broken")
-NONE, BREAKABLE, UNBREAKABLE, DUMMY, BROKEN = range(5)
 
 
 class Breakable(NamedTuple):
@@ -30,6 +26,7 @@ class Breakable(NamedTuple):
     label: str            # its YADE material's label
     mass: float           # kg
     radius: float         # m
+
 
 #: column -> (dtype, value of a new row); energies J/kg, event_max J, sizes m, mass kg
 _COLUMNS = {

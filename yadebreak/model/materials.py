@@ -14,6 +14,7 @@ import math
 import os
 import tomllib
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from types import MappingProxyType
 from typing import Mapping
@@ -21,7 +22,7 @@ from typing import Mapping
 import numpy as np
 
 from yadebreak import model
-from yadebreak.model.intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS, InputError
+from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS, InputError
 
 #: the materials shipped with the package
 MATERIALS_DIR = Path(__file__).resolve().parent.parent / "data" / "materials"
@@ -84,10 +85,11 @@ class Material:
     selection: float | None = None       # S, kg/J
     t10_max: float | None = None         # M, %
 
-    @property
+    @cached_property
     def criterion(self):
-        """This material's breakage criterion (an object of CRITERIA, named by its file's
-        breakage.model; Tavares when none): the one place where the criterion is chosen."""
+        """This material's breakage criterion (an object of a class of CRITERIA, named by its
+        file's breakage.model; Tavares when none): the one place where the criterion is chosen,
+        made once per material, so the model and the engine ask the same object."""
         return CRITERIA[self.breakage_model or "tavares"](self)
 
     @property
@@ -119,23 +121,23 @@ class Material:
     def min_energy(self, size):
         """Ab-T10, Eq. 9.1: e_min (J/kg) at size `size` (m)."""
         self._need_breakable("e_min")
-        return model.ab_t10_min_energy(size, self.e_min_ref, self.size_ref)
+        return self.criterion.min_energy(size)
 
     def fracture_energy_cdf(self, energy, size):
         """Probability that a particle of size `size` (m) has its fracture energy below `energy`:
         Eqs. 1-3 (Tavares); Eq. 9.3 (Ab-T10, where the fracture energy is the e_cum at which the
         particle breaks)."""
-        return self.criterion.fracture_energy_cdf(energy, size)
+        return self.criterion.cdf(energy, size)
 
     def fracture_energy_ppf(self, u, size):
         """The fracture energy (J/kg) at probability u for size `size` (m): Eqs. 1-3 inverted
         (Tavares); the e_cum threshold of strength u (Ab-T10, Eq. 9.3 inverted)."""
-        return self.criterion.fracture_energy_ppf(u, size)
+        return self.criterion.ppf(u, size)
 
     def sample_fracture_energy(self, rng, size):
         """One fracture energy (J/kg) per size in `size` (m), from Generator `rng`: Eqs. 1-3
         (Tavares); for Ab-T10 the e_cum threshold of a strength drawn uniform in [0, 1)."""
-        return self.criterion.sample_fracture_energy(rng, np.asarray(size, dtype=float))
+        return self.criterion.rvs(rng, size)
 
     def absorbed(self, specific_energy, partner=None):
         """e Ek/mp (J/kg): the share (Eq. 4) of `specific_energy` = Ek/mp (J/kg) this material
@@ -167,13 +169,13 @@ class Material:
 
     def t10_of_cumulative_energy(self, e_cum, size):
         """Ab-T10, Eq. 9.4: t10 (%) of a particle of size `size` (m) broken at e_cum (J/kg)."""
-        return model.ab_t10_t10(e_cum, size, self.min_energy(size), self.selection,
-                                self.size_ref, self.t10_max)
+        return self.criterion.t10_of_cumulative_energy(e_cum, size)
 
     @property
     def t10_min(self):
         """The smallest t10' (%) a breakage gives: Eq. 9 (Tavares). Ab-T10's t10 = M P(e_cum)
-        has no floor; below AB_T10_T10_FLOOR % events take the family set of that floor."""
+        has no floor; below criteria.ab_t10.AB_T10_T10_FLOOR % events take the family set of
+        that floor."""
         self._need_breakable("t10")
         return self.criterion.t10_min
 
@@ -215,28 +217,9 @@ _ELASTIC = [
     ("young_modulus", *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", 1e9),
     ("poisson_ratio", *in_file_unit(POISSON_RATIO, 1.0), "-", 1.0),
 ]
-_TAVARES = [
-    ("e_inf", 0.0, False, math.inf, False, "J/kg", 1.0),
-    ("d0", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
-    ("phi", 0.0, True, 10.0, True, "-", 1.0),
-    ("sigma", 0.0, False, 10.0, True, "-", 1.0),
-    ("emax_ratio", 1.0, False, math.inf, False, "-", 1.0),
-    ("gamma", 0.0, False, 1000.0, True, "-", 1.0),
-    ("A", 0.0, False, 100.0, True, "%", 1.0),
-    ("b_prime", 0.0, False, math.inf, False, "-", 1.0),
-    ("kappa", 0.0, False, math.inf, False, "-", 1.0),
-]
-_AB_T10 = [
-    ("e_min_ref", 0.0, True, math.inf, False, "J/kg", 1.0),
-    ("size_ref", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
-    ("selection", 0.0, False, math.inf, False, "kg/J", 1.0),
-    ("t10_max", 0.0, False, 100.0, True, "%", 1.0),
-]
-#: optional for every breakage model: the damping of fresh fragments (docs/high_energy.md)
-_GLOBAL_DAMPING = ("global_damping", 0.0, True, 1.0, False, "-", 1.0)
-#: Ab-T10 events with t10 below this (%) take the family set at this t10 (see Material.t10_min):
-#: below it the 11 classes cannot follow Eq. 10 within 2 % (2.6 % at t10 = 1 %).
-AB_T10_T10_FLOOR = 2.0
+#: optional for every breakage model: the damping of fresh fragments (docs/high_energy.md); a
+#: [breakage] key of each criterion's `keys`
+GLOBAL_DAMPING_KEY = ("global_damping", 0.0, True, 1.0, False, "-", 1.0)
 _CONTACT = [
     ("friction", 0.0, True, 10.0, True, "-", 1.0),
     ("rolling_friction", 0.0, True, 10.0, True, "-", 1.0),
@@ -245,186 +228,11 @@ _CONTACT = [
 
 
 # ------------------------------------------------------------------- the breakage criteria
-class TavaresCriterion:
-    """The Tavares UFRJ model of a material's breakage (Eqs. 1-3, 7-8): what the model layer
-    (Material, reports) asks of a criterion. coupling.criteria holds its counterpart in YADE,
-    picked by the same `name`."""
-
-    name = "tavares"
-    #: [breakage] keys of the file (see _parse_breakage) and the defaults of the optional ones
-    keys, defaults = _TAVARES + [_GLOBAL_DAMPING], {"emax_ratio": 100.0, "kappa": 1.0,
-                                                        "global_damping": 0.0}
-    #: the plots' legends of the model's breakage probability and t10
-    probability_label = "model (Eqs. 1-4)"
-    t10_label = "model: Eq. 7, e Ek/mp over E50b of the broken particles"
-
-    def __init__(self, material):
-        self.material = material
-
-    #: [breakage] keys beyond `keys`, read by parse_more
-    more_keys = {"device_stiffness"}
-
-    @staticmethod
-    def parse_more(breakage, values, problems):
-        """The keys more_keys of [breakage] into `values` (SI)."""
-        dev = _number(breakage, "device_stiffness", "breakage", problems,
-                      *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", required=False,
-                      default=model.DEVICE_STIFFNESS_STEEL / 1e9)
-        values["device_stiffness"] = None if dev is None else dev * 1e9
-
-    def median_fracture_energy(self, size):
-        """Eq. 3: E50 (J/kg) at size `size` (m), against the material's device stiffness."""
-        m = self.material
-        return model.median_fracture_energy(size, m.e_inf, m.d0, m.phi, m.hertz_stiffness,
-                                            m.device_stiffness)
-
-    def fracture_energy_cdf(self, energy, size):
-        """Eqs. 1-3: P(fracture energy < `energy` (J/kg)) at size `size` (m)."""
-        m = self.material
-        return model.fracture_energy_cdf(energy, m.median_fracture_energy(size), m.sigma,
-                                         m.emax_ratio)
-
-    def fracture_energy_ppf(self, u, size):
-        """Eqs. 1-3 inverted: the fracture energy (J/kg) at probability u, size `size` (m)."""
-        m = self.material
-        return model.fracture_energy_ppf(u, m.median_fracture_energy(size), m.sigma, m.emax_ratio)
-
-    def sample_fracture_energy(self, rng, size):
-        """One fracture energy (J/kg) per size (m, an array) from Generator `rng`."""
-        m = self.material
-        return model.sample_fracture_energy(rng, m.median_fracture_energy(size), m.sigma,
-                                            m.emax_ratio, size=size.shape)
-
-    def probability_once(self, absorbed, size):
-        """P that a fresh particle of size `size` (m) breaks when it absorbs `absorbed` (J/kg)."""
-        return self.fracture_energy_cdf(absorbed, size)
-
-    def t10(self, ratio):
-        """Eq. 8 (%); ratio = Ek' / (mp E)."""
-        m = self.material
-        return model.t10(ratio, m.A, m.b_prime, m.kappa)
-
-    def t10_once(self, absorbed, size):
-        """Eq. 7 (%) at `absorbed` (J/kg) over E50b of the particles of size `size` (m) that
-        break at it."""
-        m = self.material
-        e50b = model.median_fracture_energy_broken(absorbed, m.median_fracture_energy(size),
-                                                   m.sigma, m.emax_ratio)
-        return model.t10_batch(absorbed, e50b, m.A, m.b_prime)
-
-    @property
-    def t10_min(self):
-        """Eq. 9 (%)."""
-        m = self.material
-        return float(model.t10_primary(m.A, m.b_prime, m.kappa))
-
-    @property
-    def t10_ceiling(self):
-        """A (%), Eq. 8's largest t10'."""
-        return self.material.A
-
-    def intact_measures(self, e_cum_intact, size):
-        """What the intact particles of an impact test carry for its result: nothing here."""
-        return {}
-
-    #: the repeated-impact plot's legend of the model (see repeated_broken_fraction)
-    repeated_label = "model (Eqs. 1-6), gamma = {gamma:g}"
-
-    def repeated_broken_fraction(self, absorbed, size, impacts):
-        """Eqs. 1-6: the fraction of particles of size `size` (m) broken after each of
-        `impacts` loadings, each absorbing `absorbed` (J/kg), damage weakening the survivors."""
-        m = self.material
-        e50 = float(m.median_fracture_energy(size))
-        return model.repeated_impact_broken_fraction(absorbed, e50, m.sigma, m.emax_ratio,
-                                                     m.gamma, impacts)
-
-
-class AbT10Criterion:
-    """Rocky's Ab-T10 model of a material's breakage (docs/model.md Section 9, Eqs. 9.1-9.4);
-    see TavaresCriterion."""
-
-    name = "ab_t10"
-    keys, defaults = _AB_T10 + [_GLOBAL_DAMPING], {"global_damping": 0.0}
-    probability_label = "model P(e_cum), e_cum = e Ek/mp - e_min (Eqs. 4, 9.1-9.3)"
-    t10_label = "model: Eq. 9.4"
-
-    def __init__(self, material):
-        self.material = material
-
-    more_keys = set()
-
-    @staticmethod
-    def parse_more(breakage, values, problems):
-        """No keys beyond `keys`."""
-
-    def median_fracture_energy(self, size):
-        """The e_cum (J/kg) at which half the particles of size `size` (m) break."""
-        return self.fracture_energy_ppf(0.5, size)
-
-    def fracture_energy_cdf(self, energy, size):
-        """Eq. 9.3: P(e_cum threshold < `energy` (J/kg)) at size `size` (m)."""
-        m = self.material
-        return model.ab_t10_probability(energy, size, m.min_energy(size), m.selection, m.size_ref)
-
-    def fracture_energy_ppf(self, u, size):
-        """Eq. 9.3 inverted: the e_cum threshold (J/kg) of strength u, size `size` (m)."""
-        m = self.material
-        return model.ab_t10_threshold(u, size, m.min_energy(size), m.selection, m.size_ref)
-
-    def sample_fracture_energy(self, rng, size):
-        """The e_cum threshold (J/kg) of a strength drawn uniform in [0, 1), per size (m)."""
-        return self.fracture_energy_ppf(rng.random(size.shape), size)
-
-    def probability_once(self, absorbed, size):
-        """P(e_cum) of the e_cum one loading absorbing `absorbed` (J/kg) leaves (Eqs. 9.2-9.3)."""
-        m = self.material
-        return self.fracture_energy_cdf(model.ab_t10_single_impact_cum(absorbed,
-                                                                       m.min_energy(size)), size)
-
-    def t10(self, ratio):
-        raise ValueError(f"material '{self.material.name}' uses Ab-T10: its t10 comes from e_cum "
-                         "(t10_of_cumulative_energy), not from Eq. 8")
-
-    def t10_once(self, absorbed, size):
-        """The mean of Eq. 9.4 (%) over the particles that break after one loading absorbing
-        `absorbed` (J/kg): M P / 2; NaN where none breaks."""
-        m = self.material
-        e_cum = model.ab_t10_single_impact_cum(absorbed, m.min_energy(size))
-        t10 = 0.5 * m.t10_of_cumulative_energy(e_cum, size)
-        return np.where(t10 > 0.0, t10, np.nan)
-
-    @property
-    def t10_min(self):
-        """No floor in Eq. 9.4: AB_T10_T10_FLOOR (%), or M / 2 when smaller."""
-        return min(AB_T10_T10_FLOOR, 0.5 * self.material.t10_max)
-
-    @property
-    def t10_ceiling(self):
-        """M (%), Eq. 9.4's largest t10."""
-        return self.material.t10_max
-
-    def intact_measures(self, e_cum_intact, size):
-        """The mean e_cum (J/kg) the intact particles of an impact test carry (what the broken
-        ones would have reached) and P of it."""
-        if not e_cum_intact:
-            return {}
-        e_cum = float(np.mean(e_cum_intact))
-        return {"e_cum_measured": e_cum,
-                "p_of_e_cum_measured": float(self.fracture_energy_cdf(e_cum, size))}
-
-    repeated_label = "model P(e_cum), e_cum = k (e Ek/mp - e_min) (Eqs. 9.1-9.3)"
-
-    def repeated_broken_fraction(self, absorbed, size, impacts):
-        """Eqs. 9.1-9.3: the fraction broken after each of `impacts` loadings, each absorbing
-        `absorbed` (J/kg), e_cum adding up over the impacts."""
-        m = self.material
-        return model.ab_t10_repeated_broken_fraction(absorbed, size, float(m.min_energy(size)),
-                                                     m.selection, m.size_ref, impacts)
-
-
-#: breakage.model -> its criterion: the one registry (coupling.criteria picks its YADE-side
-#: counterpart by the same name)
-CRITERIA = {c.name: c for c in (TavaresCriterion, AbT10Criterion)}
+#: breakage.model -> its criterion class (yadebreak.criteria: one class per criterion, holding
+#: its [breakage] keys, distribution, t10 and engine side): the one registry. This room may not
+#: import the criteria, so they register here (criteria.base.register) when `import yadebreak`
+#: imports them; the parser and Material.criterion read it.
+CRITERIA = {}
 
 
 _TOP_KEYS = {"name", "description", "kind", "breakable", "contact_like", "elastic", "breakage",
@@ -554,8 +362,9 @@ def _parse_breakage(doc, values, problems):
     breakage = _read_table(doc, "breakage", "", problems)
     model_name = breakage.get("model", "tavares")
     if model_name not in CRITERIA:
-        problems.append(f"breakage.model = {model_name!r}: accepted 'tavares' (the default) "
-                        "or 'ab_t10'")
+        accepted = " or ".join(f"{n!r}" + (" (the default)" if n == "tavares" else "")
+                               for n in CRITERIA)
+        problems.append(f"breakage.model = {model_name!r}: accepted {accepted}")
         model_name = "tavares"
     criterion = CRITERIA[model_name]
     allowed = {k[0] for k in criterion.keys} | {"model", "beta", "beta_source"}

@@ -8,7 +8,10 @@ per module:
   run's outputs, spectra synthesised from a documented rule.
 - capture: the mass a collision captures (monolayer) and the energy each captured particle gets.
 - population: the state (a discretised fracture-energy distribution per class, fines) and its
-  time integration with damage (Eqs. 5-6), t10 (Eq. 8) and progeny (Eq. 10).
+  time integration with damage (Eqs. 5-6), t10 (Eq. 8) and progeny (Eq. 10), BatchGrinder.
+- grid: the fracture-energy cells of each class and Eq. 6's weakening tabulated (FractureGrid,
+  DamageTable).
+- progeny: where broken mass goes: t10 (Eqs. 8-9) and Eq. 10 over the classes (Progeny).
 - reference: closed forms the integration is tested against (Reid's solution).
 """
 from yadebreak.studies.grinding.classes import SizeClasses, feed_masses, read_psd_csv, root2_classes

@@ -33,6 +33,8 @@ import numpy as np
 from yadebreak import model
 from yadebreak.studies.grinding.capture import CaptureModel
 from yadebreak.studies.grinding.classes import SizeClasses
+from yadebreak.studies.grinding.grid import DamageTable, FractureGrid
+from yadebreak.studies.grinding.progeny import Progeny
 
 
 class GrindingError(ValueError):
@@ -136,27 +138,15 @@ class BatchGrinder:
         self.holdup = float(spectra.ore_mass_kg if holdup_mass is None else holdup_mass)
         self.capture = CaptureModel(material.density, spectra.ball_diameter_m,
                                     spectra.ore_coverage)
-        self._grid()
+        self.grid = FractureGrid(material.criterion, self.sizes, cells)
+        self.log_e, self.width, self.fresh = self.grid.log_e, self.grid.width, self.grid.fresh
+        self.damage_table = DamageTable(material.gamma, damage)
+        self.log_keep = self.damage_table.log_keep
+        self.breakage = Progeny(material, classes, t10_at, breakage_matrix, GrindingError)
+        self.t10_grid = self.breakage.t10_grid
         self._mill()
-        self._damage_table()
-        self.matrix = None if breakage_matrix is None else self._check_matrix(breakage_matrix)
-        if self.matrix is None:
-            self._progeny_table()
 
     # -- set-up ------------------------------------------------------------------------------
-    def _grid(self):
-        """ln E cells per class, from 1e-3 of the 0.01 % quantile (room for damage) up to the
-        1 - 1e-7 quantile, and the fresh distribution's mass fraction in each (Eqs. 1-3)."""
-        mat, d = self.material, self.sizes
-        lo = np.log(1e-3 * mat.fracture_energy_ppf(1e-4, d))
-        hi = np.log(mat.fracture_energy_ppf(1.0 - 1e-7, d))
-        self.width = (hi - lo) / (self.cells - 1)                           # (n,)
-        self.log_e = lo[:, None] + self.width[:, None] * np.arange(self.cells)   # (n, K)
-        edges = self.log_e[:, 1:] - 0.5 * self.width[:, None]
-        cdf = mat.fracture_energy_cdf(np.exp(edges), d[:, None])
-        cdf = np.concatenate([np.zeros((self.n, 1)), cdf, np.ones((self.n, 1))], axis=1)
-        self.fresh = np.diff(cdf, axis=1)                                    # rows sum to 1
-
     def _mill(self):
         """Per spectrum row: rate nu (1/s), energy given to the ore (J, Eq. 4 share against steel
         for 'collision' spectra), geometry; lambda[i, j] the fraction of class i stressed per s."""
@@ -170,48 +160,6 @@ class BatchGrinder:
         mono = self.capture.monolayer_mass(self.sizes[:, None], self.plane[None, :])
         self.lam = self.rate[None, :] * mono / self.holdup                  # (n, J)
         self.collision_power = float(np.sum(self.rate * s.energy_J))        # W
-
-    def _damage_table(self):
-        """ln(1 - D) of Eq. 6 against ln r, tabulated once (the Newton solve per cell and step
-        would cost most of a step); zero when damage is off."""
-        x = np.linspace(math.log(1e-10), math.log(30.0), 4001)   # ln(-ln(1 - r))
-        r = -np.expm1(-np.exp(x))
-        d = np.minimum(model.damage(r, self.material.gamma), 1.0 - 1e-15)
-        self._tab_log_r = np.log(r)
-        self._tab_log_keep = np.log1p(-d)
-
-    def log_keep(self, log_ratio):
-        """ln(1 - D(r)) (Eq. 6) for ln r < 0, from the table; 0 without damage."""
-        if not self.damage_on:
-            return np.zeros_like(log_ratio)
-        return np.interp(log_ratio, self._tab_log_r, self._tab_log_keep, left=0.0,
-                         right=self._tab_log_keep[-1])
-
-    def _progeny_table(self):
-        """Fractions of a broken particle of class i at t10 (grid of 101 values from Eq. 9's
-        t10_min to A: a breakage has e >= E) that
-        land in each class l >= i and the fines: Eq. 10 (model.progeny_passing) at the sieves
-        over the parent's representative size."""
-        mat = self.material
-        self.t10_grid = np.linspace(mat.t10_min, mat.A, 101)
-        table = np.zeros((self.n, len(self.t10_grid), self.n + 1))
-        sieves = self.classes.sieves
-        for i in range(self.n):
-            passing = model.progeny_passing(self.t10_grid, mat.beta_params,
-                                            sieves[i:] / self.sizes[i]) / 100.0   # (G, n+1-i)
-            passing[:, 0] = 1.0
-            table[:, :, i:self.n][i] = passing[:, :-1] - passing[:, 1:]
-            table[i, :, self.n] = passing[:, -1]
-        self.progeny = table
-
-    def _check_matrix(self, matrix):
-        matrix = np.asarray(matrix, dtype=float)
-        if (matrix.shape != (self.n + 1, self.n) or np.any(matrix < 0)
-                or not np.allclose(matrix.sum(axis=0), 1.0, rtol=0, atol=1e-12)
-                or np.any(np.triu(matrix[:self.n], 1) > 0)):
-            raise GrindingError(f"breakage_matrix: needs shape ({self.n + 1}, {self.n}), "
-                                "non-negative columns summing to 1, nothing above the parent")
-        return matrix
 
     # -- state ---------------------------------------------------------------------------------
     def fresh_state(self, class_masses, fines=0.0):
@@ -232,7 +180,7 @@ class BatchGrinder:
         masses, fines = state.cells.sum(axis=1), state.fines
         if state.unbreakable is None:
             return masses, fines
-        spread = np.einsum("ig,igl->l", state.spent, self.progeny)
+        spread = np.einsum("ig,igl->l", state.spent, self.breakage.table)
         return masses + state.unbreakable.sum(axis=1) + spread[:self.n], fines + spread[self.n]
 
     def stressing(self, cells, fines):
@@ -290,12 +238,13 @@ class BatchGrinder:
         new, broken, log_b = self._stress(state.cells, log_r, q, total, drift * dt, dt,
                                           self.damage_on)
         broken_class = broken.sum(axis=(1, 2))
-        if self.matrix is not None:
-            progeny = self.matrix @ broken_class
-            same = np.diag(self.matrix[:n]) * broken_class
+        matrix = self.breakage.matrix
+        if matrix is not None:
+            progeny = matrix @ broken_class
+            same = np.diag(matrix[:n]) * broken_class
         else:
-            weights = self._t10_weights(broken, self._t10(log_b))          # (n, G)
-            per_class = np.einsum("ig,igl->il", weights, self.progeny)     # (n, n+1)
+            weights = self._t10_weights(broken, self.breakage.t10(log_b))   # (n, G)
+            per_class = self.breakage.spread(weights)                      # (n, n+1)
             progeny = per_class.sum(axis=0)
             same = np.diag(per_class[:, :n])
         left = broken_class - same
@@ -307,8 +256,8 @@ class BatchGrinder:
         # unbreakable progeny: no damage; a stressing past E records t10 and ends their stressing
         unb, broken_u, log_bu = self._stress(state.unbreakable, log_r, q, total,
                                              np.zeros_like(self.log_e), dt, False)
-        once = self._t10_weights(broken_u, self._t10(log_bu))              # (n, G)
-        spread = np.einsum("ig,igl->il", once, self.progeny)
+        once = self._t10_weights(broken_u, self.breakage.t10(log_bu))     # (n, G)
+        spread = self.breakage.spread(once)
         left = left + once.sum(axis=1) - np.diag(spread[:, :n])            # as a sieve sees it
         to_unb = np.where(self.unbreakable_class, progeny[:n], 0.0)
         new += (progeny[:n] - to_unb)[:, None] * self.fresh
@@ -338,36 +287,13 @@ class BatchGrinder:
         if damage:
             target_s = target_s + self.log_keep(np.minimum(log_ej - log_s, 0.0))
         keep = cells * (1.0 - stressed)
-        new = self._deposit(keep, self.log_e + shift, survive, target_s)
+        new = self.grid.deposit(keep, self.log_e + shift, survive, target_s)
         log_b = log_ej - 0.5 * (log_e - half + np.minimum(log_ej, log_e + half))
         return new, broken, log_b
 
-    def _t10(self, log_ratio):
-        """t10 (%) of breakages at mean ln(e_j / E) `log_ratio`: Eq. 8 at the ratio (at least 1),
-        or Eq. 9's t10_min for t10_at="threshold"."""
-        return self._t10_at_ratio(np.exp(np.maximum(log_ratio, 0.0)))
-
-    def _t10_at_ratio(self, ratio):
-        """t10 (%) of breakages at e_j / E = `ratio` (>= 1), by t10_at."""
-        if self.t10_at == "threshold":
-            return np.full(np.shape(ratio), self.material.t10_min)
-        return self.material.t10(ratio)
-
-    def _deposit(self, keep, keep_at, moved, moved_at):
-        """Masses `keep` (n, K) at ln E `keep_at` and `moved` (n, J, K) at `moved_at` put back
-        on each class's grid (clipped to its ends)."""
-        out = np.zeros(self.n * self.cells)
-        for m, at in ((keep, keep_at), (moved, moved_at)):
-            shape = (self.n,) + (1,) * (at.ndim - 1)
-            pos = (at - self.log_e[:, 0].reshape(shape)) / self.width.reshape(shape)
-            out += _split_linear(pos, m, self.cells)
-        return out.reshape(self.n, self.cells)
-
     def _t10_weights(self, broken, t10):
-        """Broken mass per class (n, J, K) on the t10 grid: (n, G)."""
-        g = len(self.t10_grid)
-        lo, hi = self.t10_grid[0], self.t10_grid[-1]
-        return _split_linear((t10 - lo) / (hi - lo) * (g - 1), broken, g).reshape(self.n, g)
+        """Broken mass per class (n, J, K) on the t10 grid: (n, G) (Progeny.weights)."""
+        return self.breakage.weights(broken, t10)
 
     # -- time integration --------------------------------------------------------------------
     def run(self, class_masses, fines, output_times_s, residence_time_s=None, progress=None):
@@ -430,23 +356,17 @@ class BatchGrinder:
         cells, fines = self.fresh_state(class_masses, fines)
         e, _ = self.stressing(cells, fines)
         if not net:
-            p = self.material.fracture_energy_cdf(e[None, :], self.sizes[:, None])
+            p = self.material.criterion.cdf(e[None, :], self.sizes[:, None])
             return (self.lam * p).sum(axis=1)
         u = (np.arange(quantiles) + 0.5) / quantiles
         out = np.zeros(self.n)
         for i, d in enumerate(self.sizes):
-            energy = self.material.fracture_energy_ppf(u, d)                   # (Q,)
+            energy = self.material.criterion.ppf(u, d)                         # (Q,)
             ratio = e[:, None] / energy[None, :]                               # (J, Q)
-            leaving = 1.0 - self._retained(i, self._t10_at_ratio(np.maximum(ratio, 1.0)))
+            leaving = 1.0 - self.breakage.retained(
+                i, self.breakage.t10_at_ratio(np.maximum(ratio, 1.0)))
             out[i] = np.sum(self.lam[i] * np.mean(np.where(ratio >= 1.0, leaving, 0.0), axis=1))
         return out
-
-    def _retained(self, i, t10):
-        """Share of a broken particle of class i (t10 %) that stays in class i: its progeny
-        coarser than the class's lower sieve (Eq. 10, from the progeny table)."""
-        if self.matrix is not None:
-            return np.full(np.shape(t10), self.matrix[i, i])
-        return np.interp(t10, self.t10_grid, self.progeny[i, :, i])
 
 
 @dataclass
@@ -483,19 +403,6 @@ def _stressed_share(cells, total):
     stressed = (total * cells).sum(axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(mass > 0, stressed / mass, 0.0)
-
-
-def _split_linear(pos, mass, count):
-    """Masses (first axis: class) at fractional grid positions `pos` (same shape, clipped to
-    [0, count - 1]) split between the two nearest of `count` nodes per class, linearly: each
-    mass and its mean position are kept. Returns the flat (classes * count) totals."""
-    pos = np.clip(pos, 0.0, count - 1.0)
-    k0 = np.minimum(np.floor(pos).astype(int), count - 2)
-    frac = pos - k0
-    rows = mass.shape[0]
-    idx = ((np.arange(rows) * count).reshape((rows,) + (1,) * (pos.ndim - 1)) + k0).ravel()
-    out = np.bincount(idx, weights=(mass * (1.0 - frac)).ravel(), minlength=rows * count)
-    return out + np.bincount(idx + 1, weights=(mass * frac).ravel(), minlength=rows * count)
 
 
 def _mean_mass(before, after):

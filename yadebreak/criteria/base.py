@@ -1,0 +1,127 @@
+"""The Criterion base: what every breakage criterion answers, for the model (its fracture-energy
+distribution and t10) and for the engine (judge, unload, breakage), and the one registry of the
+criteria a material file may name (`breakage.model`).
+
+Public methods check and convert their input, then call the criterion's hooks (scipy.stats'
+shape): a criterion writes `_cdf`, `_ppf` and `_rvs`, and the engine-side methods below. The
+registry is model.materials.CRITERIA (the model reads it to parse a file and to build
+Material.criterion, and may not import this room); `register` is its one writer. Adding a
+criterion is one file of this folder: a subclass decorated with @register, imported by
+criteria/__init__.py.
+
+Model side, energies in J/kg and sizes in m, numpy arrays of any shape:
+    cdf(energy, size), ppf(u, size), rvs(rng, size)    the fracture-energy distribution
+    median_fracture_energy(size), probability_once(absorbed, size), t10(ratio), t10_once(...),
+    t10_min, t10_ceiling, intact_measures(...), repeated_broken_fraction(...)
+Engine side, on the columns of the engine's body table (engine/state.BodyTable), no yade:
+    judge(table, ids, ek, specific) -> Judgement   which of the bodies read now break
+    judge_one(columns, i, ek, specific) -> tuple   the same function on one body (scalars)
+    unload(table, i) -> event fields or None        a stressing event ended without breakage
+    breakage(table, i, ek) -> (ratio, t10, extra)   the t10' of a breakage
+    t10_at_threshold(table, i, threshold) -> t10    the t10' of a breakage right at the threshold
+    force(table, i, ratio) -> ek                    a breakage imposed by break_body()
+    sample(rng, sizes) -> (fracture energies, extra columns)   state of a new body
+    energy_to_break(table, ids) -> J/kg             the least one event must bring to break them
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from yadebreak.criteria.judgement import Judgement
+from yadebreak.model.materials import CRITERIA
+
+
+class Criterion:
+    """One breakage criterion of one material (`self.material`, a model.materials.Material)."""
+
+    #: the file's breakage.model naming this criterion (None: not named by files)
+    name = None
+    #: [breakage] keys of a material file, as (key, lower, lower inclusive, upper, upper
+    #: inclusive, unit in file, SI factor), the defaults of the optional ones, and the keys
+    #: beyond these that parse_more reads
+    keys, defaults, more_keys = (), {}, frozenset()
+    #: the plots' legends of the model's breakage probability, t10 and repeated impacts
+    probability_label = t10_label = repeated_label = ""
+    #: bodies of a lower order are settled first in a read (Controller._settle)
+    order = 0
+    #: steps after its creation during which a fragment counts no energy
+    default_pause_steps = 0
+    #: reads of up to this many bodies are judged one by one (judging.Judge)
+    judged_one_by_one = 1
+    #: what unload()'s events are logged as
+    event_kind = "damage"
+
+    def __init__(self, material):
+        self.material = material
+
+    @staticmethod
+    def parse_more(breakage, values, problems):
+        """The keys more_keys of [breakage] into `values` (SI): none here."""
+
+    def with_successive_kappa(self, kappa_successive):
+        """This criterion with Eq. 8's kappa of fragments set (criteria without Eq. 8: itself)."""
+        return self
+
+    # -- the fracture-energy distribution ---------------------------------------------------
+    def cdf(self, energy, size):
+        """P(fracture energy < `energy` (J/kg)) of particles of size `size` (m)."""
+        return self._cdf(energy, size)
+
+    def ppf(self, u, size):
+        """The fracture energy (J/kg) at probability u, size `size` (m): cdf inverted."""
+        return self._ppf(u, size)
+
+    def rvs(self, rng, size):
+        """One fracture energy (J/kg) per size in `size` (m), drawn with numpy Generator `rng`."""
+        return self._rvs(rng, np.asarray(size, dtype=float))
+
+    def median_fracture_energy(self, size):
+        """The fracture energy (J/kg) half the particles of size `size` (m) stay below."""
+        return self.ppf(0.5, size)
+
+    # -- engine side --------------------------------------------------------------------------
+    def overridden(self, kappa=None, emax_ratio=None):
+        """The material with attach()'s overrides applied (criteria without them: unchanged)."""
+        return self.material
+
+    def sample(self, rng, sizes):
+        """Fracture energies (J/kg) of new bodies of `sizes` (m), and no further columns."""
+        return self.rvs(rng, sizes), {}
+
+    def judge(self, table, ids, ek, specific):
+        """judge_one on the bodies `ids` (arrays), as a Judgement."""
+        return Judgement(*self.judge_one(table.columns, ids, ek, specific))
+
+    def t10_at_threshold(self, table, i, threshold):
+        """The t10' (%) body i would have had, broken at its threshold `threshold` (J/kg, its
+        fracture energy): what a read at the crossing gives (the warning of a late read)."""
+        raise NotImplementedError
+
+
+def register(cls):
+    """Class decorator: `cls` becomes the criterion of materials whose file names cls.name."""
+    if cls.name in CRITERIA:
+        raise ValueError(f"criterion name {cls.name!r} registered twice "
+                         f"({CRITERIA[cls.name].__name__} and {cls.__name__})")
+    CRITERIA[cls.name] = cls
+    return cls
+
+
+def criterion_class(name):
+    """The registered criterion class named `name` (a file's breakage.model)."""
+    if name not in CRITERIA:
+        raise ValueError(f"criterion = {name!r}: accepted {', '.join(map(repr, CRITERIA))}")
+    return CRITERIA[name]
+
+
+def criterion_for(material, breakage=True, kappa_successive=None):
+    """The criterion of a breakable Material for the engine: material.criterion itself (the
+    object the model side uses), with Eq. 8's kappa of fragments when kappa_successive is given
+    (Tavares; None: the material's), wrapped in Recording when breakage=False."""
+    criterion = material.criterion
+    if kappa_successive is not None:
+        criterion = criterion.with_successive_kappa(kappa_successive)
+    if breakage:
+        return criterion
+    from yadebreak.criteria.recording import Recording
+    return Recording(criterion)
