@@ -256,9 +256,9 @@ def test_both_judge_paths_make_the_same_decisions(seed, at_peak):
             ids = np.array(sorted(st.tracked))
             st.table.columns["cracked"][ids[::3]] = 1
         records = []
-        judge = judging.Judge(st, crits, ContactReader({}, 0.0, 1e-4), 0.7 if seed % 2 else 1.0,
-                              True, 0.02, lambda kind, i, **f: records.append((kind, i, f)),
-                              lambda *a: None, at_peak)
+        rules = judging.Rules(0.7 if seed % 2 else 1.0, 0.02, at_peak, pausing=True)
+        judge = judging.Judge(st, crits, ContactReader({}, 0.0, 1e-4), rules,
+                              record=lambda kind, i, **f: records.append((kind, i, f)))
         candidates = list(st.open_events.union(loading.energy))
         plan = getattr(judge, path)(candidates, loading, 3, 10, True)
         broken = judge.settle(candidates, plan, loading)
@@ -318,7 +318,7 @@ def test_break_at_peak_waits_for_the_event_to_stop_rising_and_takes_its_largest_
                      fracture_energy_initial=energy)
         st.tracked.add(0)
         judge = judging.Judge(st, [criteria.criterion_for(cu)], ContactReader({}, 0.0, 1e-4),
-                              1.0, False, 0.02, lambda *a, **f: None, lambda *a: None, at_peak)
+                              judging.Rules(1.0, 0.02, at_peak))
         for read, specific in enumerate(history):
             loading = Loading({0: specific * mass})
             broken, _ = judge.judge(loading, 1, read, False)

@@ -17,8 +17,8 @@ from yadebreak.analysis import reports
 from yadebreak.adapter.yade_api import O, utils
 from yadebreak.engine.contacts import ContactReader, Strongest
 from yadebreak.criteria import criterion_for
-from yadebreak.engine.judging import Judge
-from yadebreak.engine.replacement import Replacer
+from yadebreak.engine.judging import Judge, Rules
+from yadebreak.engine.replacement import Recipe, Replacer
 from yadebreak.engine.state import BREAKABLE, BROKEN, UNBREAKABLE, EngineState
 from yadebreak.engine.stepping import FragmentDamping, ReadSchedule, TimeStep
 from yadebreak.engine.tracking import Tracking
@@ -86,22 +86,26 @@ class Controller:
         self.damping = FragmentDamping(
             {lab: (gd if gd is not None else mat.global_damping)
              for lab, mat in self.material.items()}, config.time_step.global_damping_time)
-        tables = {lab: families.table_for(mat, config.replacement.family_seed)
-                  for lab, mat in self.material.items()}
-        dummy_material = (scene_materials.dummy_by_label
-                          if config.replacement.dummy_stiffness != 1.0 else {})
-        self.replacer = Replacer(config.replacement, self.state.table, self.state.rng,
-                                 self.criteria, tables, self.zeroing, self.reader,
-                                 self.state.ledger, self.pause_steps,
-                                 self.damping.damped_labels, dummy_material)
-        self.judge = Judge(self.state, self._criterion_of, self.reader,
-                           config.criteria.fragments_energy_factor,
-                           any(self.pause_steps.values()), config.reading.fast_tolerance,
-                           self._record, self._warn_jump,
-                           config.criteria.break_at == "peak")
-        self.judge.weakened = self.tracking.weakened
+        self.replacer = Replacer(config.replacement, self.state,
+                                 self._recipes(scene_materials), self.zeroing, self.reader)
+        rules = Rules(config.criteria.fragments_energy_factor, config.reading.fast_tolerance,
+                      config.criteria.break_at == "peak", any(self.pause_steps.values()))
+        self.judge = Judge(self.state, self._criterion_of, self.reader, rules,
+                           record=self._record, warn_jump=self._warn_jump,
+                           weakened=self.tracking.weakened)
         self.last_iter = -1
         self.wall_time = {"read": 0.0, "replace": 0.0}
+
+    def _recipes(self, scene_materials):
+        """Replacement.Recipe of each breakable material."""
+        config, damped = self.config, self.damping.damped_labels
+        dummies = (scene_materials.dummy_by_label
+                   if config.replacement.dummy_stiffness != 1.0 else {})
+        return {lab: Recipe(self.criteria[lab],
+                            families.table_for(mat, config.replacement.family_seed),
+                            self.pause_steps[lab], (lab in damped) if damped else None,
+                            dummies.get(lab))
+                for lab, mat in self.material.items()}
 
     # -- what users read ---------------------------------------------------------------------
     @property

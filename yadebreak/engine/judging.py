@@ -11,6 +11,7 @@ an id and scalars or on ids and arrays) and give the same decisions and numbers
 (tests/test_engine_parts.py)."""
 from __future__ import annotations
 
+from dataclasses import dataclass
 from itertools import repeat
 
 import numpy as np
@@ -49,21 +50,35 @@ class Plan:
         self.jump, self.threshold, self.limits = jump, threshold, limits
 
 
-class Judge:
-    """Judges the bodies a read found loaded (or with an open event)."""
+@dataclass(frozen=True)
+class Rules:
+    """The options a judge follows."""
 
-    def __init__(self, state, criterion_of, reader, energy_factor, pausing, fast_tolerance,
-                 record, warn_jump, at_peak=False):
+    energy_factor: float            # fragments_energy_factor
+    fast_tolerance: float           # read_period="fast": see steps_allowed
+    at_peak: bool = False           # break_at="peak"
+    pausing: bool = False           # some material pauses fresh fragments
+
+
+def _ignore(*args, **fields):
+    return None
+
+
+class Judge:
+    """Judges the bodies a read found loaded (or with an open event), and tells `record(kind,
+    id, **fields)` of each event, `warn_jump(id, rise, threshold, Ek')` of a read that came
+    late, `weakened(id)` of each body a damage weakened."""
+
+    def __init__(self, state, criterion_of, reader, rules, *, record=_ignore, warn_jump=_ignore,
+                 weakened=_ignore):
         self.state = state
-        self.at_peak = at_peak                    # break_at="peak"
         self.criterion_of = criterion_of          # material index -> criterion
         self.reader = reader                      # contacts.ContactReader
-        self.energy_factor = energy_factor        # fragments_energy_factor
-        self.pausing = pausing                    # some material pauses fresh fragments
-        self.fast_tolerance = fast_tolerance
-        self.record = record                      # record(kind, id, **fields)
-        self.warn_jump = warn_jump                # warn_jump(id, rise, threshold, Ek')
-        self.weakened = lambda bid: None          # told of each body a damage weakened
+        self.at_peak = rules.at_peak
+        self.energy_factor = rules.energy_factor
+        self.pausing = rules.pausing
+        self.fast_tolerance = rules.fast_tolerance
+        self.record, self.warn_jump, self.weakened = record, warn_jump, weakened
         #: up to this many candidates a read is judged body by body (plan_each)
         self.small = min([SMALL, *(c.judged_one_by_one for c in criterion_of)])
 

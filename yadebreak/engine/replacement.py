@@ -76,22 +76,29 @@ def _sphere_body(material, center, radius, mass, vel, angvel, damped):
     return b
 
 
+@dataclass(frozen=True)
+class Recipe:
+    """How the progeny of one breakable material are made."""
+
+    criterion: object      # draws the fragments' fracture energies (criteria.Criterion)
+    families: object       # model.families.FamilyTable: the family of an event's t10'
+    pause_steps: int       # steps a fresh fragment is not judged (0: none)
+    damped: object         # True/False: fragments start damped (global damping); None: no
+    #                        material of the scene is damped (YADE's default is left alone)
+    dummy_material: object  # YADE material of its dummies (a softer one), None: its own
+
+
 class Replacer:
     """Replaces broken spheres; one per engine."""
 
-    def __init__(self, options, table, rng, criteria, families, zeroing, reader, ledger,
-                 pause_steps, damped, dummy_material=None):
+    def __init__(self, options, state, recipes, zeroing, reader):
         self.options = options         # config.Replacement
-        self.table = table
-        self.rng = rng
-        self.criteria = criteria       # material label -> criterion
-        self.families = families       # material label -> families.FamilyTable
+        self.table = state.table
+        self.rng = state.rng
+        self.ledger = state.ledger
+        self.recipes = recipes         # material label -> Recipe
         self.zeroing = zeroing
         self.reader = reader           # told which contacts the fragments inherit
-        self.ledger = ledger
-        self.pause_steps = pause_steps  # material label -> steps
-        self.damped = damped           # labels whose fragments start damped (global damping)
-        self.dummy_material = dummy_material or {}     # label -> softer YADE material (option)
 
     def replace(self, bid, t10, direction, dmin):
         """Erase body `bid` and insert its progeny for t10' (%), coarse fragments across
@@ -100,7 +107,8 @@ class Replacer:
         label = self.table.label_of(bid)
         radius = float(self.table.columns["radius"][bid])
         mass = float(self.table.columns["mass"][bid])
-        fam = self.families[label].draw(self.rng, t10)
+        recipe = self.recipes[label]
+        fam = recipe.families.draw(self.rng, t10)
         center = np.array(body.state.pos)
         radii = fam.relative_sizes * radius
         centers = placement.place_fragments(center, radius, radii, direction, self.rng)
@@ -127,8 +135,8 @@ class Replacer:
         kinetic_after = 0.5 * float(masses @ (vel * vel).sum(axis=1)
                                     + inertias.sum() * spin @ spin)
         radii, centers, masses, vel = radii[keep], centers[keep], masses[keep], vel[keep]
-        damped = (label in self.damped) if self.damped else None
-        soft = self.dummy_material.get(label, material)
+        damped = recipe.damped
+        soft = recipe.dummy_material or material
         kinds = [soft if d else material for d in fam.is_dummy[keep].tolist()]
         new = [_sphere_body(k, c, r, m, v, spin, damped)
                for k, c, r, m, v in zip(kinds, centers.tolist(), radii.tolist(), masses.tolist(),
@@ -164,7 +172,8 @@ class Replacer:
         kinds = np.where(is_dummy, DUMMY,
                          np.where(model.X_MIN * 2.0 * radii < dmin, UNBREAKABLE, BREAKABLE))
         values = {"generation": generation}
-        pause = self.pause_steps[label]
+        recipe = self.recipes[label]
+        pause = recipe.pause_steps
         if pause:
             values["pause_until"] = O.iter + pause
         self.table.add(ids, kinds, label, masses, radii, **values)
@@ -174,7 +183,7 @@ class Replacer:
         self.table.columns["parent_size"][dummies] = parent_size
         need = np.nonzero(~is_dummy)[0]
         if len(need):
-            energies, extra = self.criteria[label].sample(self.rng, 2.0 * radii[need])
+            energies, extra = recipe.criterion.sample(self.rng, 2.0 * radii[need])
             c = self.table.columns
             c["fracture_energy"][ids[need]] = energies
             c["fracture_energy_initial"][ids[need]] = energies
