@@ -661,7 +661,8 @@ def test_an_append_that_fails_leaves_the_file_as_it_was(tmp_path, monkeypatch):
 
     def open_half_full(file, mode="r"):
         return HalfFull(io.open(file, mode + "b"))
-    monkeypatch.setattr(lifecycle, "open", open_half_full, raising=False)
+    from yadebreak.process import files
+    monkeypatch.setattr(files, "open", open_half_full, raising=False)
     with pytest.raises(OSError):
         lifecycle.append_whole(path, '{"b": 2}\n{"c": 3}\n')
     assert path.read_text() == '{"a": 1}\n'

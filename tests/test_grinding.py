@@ -15,7 +15,7 @@ from scipy.linalg import expm
 from yadebreak.studies.grinding import (BatchGrinder, GrindingError, SpectraError, feed_masses,
                                 from_mill_run, read_spectra, reid_batch, root2_classes,
                                 synthetic_spectra, write_spectra)
-from yadebreak.studies.grinding.capture import PACKING_MONOLAYER
+from yadebreak.model.capture import PACKING_MONOLAYER
 from yadebreak.studies.grinding.classes import FeedError
 from yadebreak.studies.grinding.cli import parse_feed
 from yadebreak.model.materials import load_material

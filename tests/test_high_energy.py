@@ -102,7 +102,7 @@ def test_a_fragment_counts_no_work_for_the_overlap_it_inherits(scene):
     brk, ids = scenes.impact_scene("copper_ore", 10e-3, [0.0], seed=1, local_damping=0.5)
     brk.break_body(ids[0], ratio=20.0)
     run_steps(1)
-    r = brk.reader
+    r = brk.reader.table
     pushing = r.force > 0.0
     assert pushing.sum() >= 10
     work, force, overlap = r.work[pushing], r.force[pushing], r.overlap[pushing]

@@ -6,6 +6,7 @@ named in ALLOWED (and itself); a study may reach the engine, scenes and jobs onl
     criteria/  one class per criterion                      model
     options/   the option table, the flags of scripts       model, criteria
     analysis/  results against the model, plots             model, criteria
+    process/   errors in one line, signals, whole files       nothing (every room may use it)
     adapter/   the one module that imports yade             nothing
     engine/    the engine and its parts in YADE's loop      model, criteria, options, analysis, adapter
     scenes/    every builder of a YADE scene                 ... and engine
@@ -21,18 +22,19 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parent.parent / "yadebreak"
-PURE = {"model", "criteria", "options", "analysis"}
+PURE = {"model", "criteria", "options", "analysis", "process"}
 ALLOWED = {
-    "model": {"model"},
-    "criteria": {"model", "criteria"},
-    "options": {"model", "criteria", "options"},
-    "analysis": {"model", "criteria", "analysis"},
-    "adapter": {"adapter"},
+    "process": {"process"},
+    "model": {"model", "process"},
+    "criteria": {"model", "criteria", "process"},
+    "options": {"model", "criteria", "options", "process"},
+    "analysis": {"model", "criteria", "analysis", "process"},
+    "adapter": {"adapter", "process"},
     "engine": PURE | {"adapter", "engine"},
     "scenes": PURE | {"adapter", "engine", "scenes"},
     "jobs": PURE | {"engine", "scenes", "jobs"},
     "studies": PURE | {"jobs", "studies"},
-    "coupling": {"engine", "coupling"},
+    "coupling": {"engine", "coupling", "process"},
     "cli": PURE | {"engine", "scenes", "jobs", "studies", "cli"},
 }
 #: what a study may import inside a function (it runs scenes in its own process or others)

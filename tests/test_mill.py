@@ -121,7 +121,7 @@ def test_the_spectra_run_breaks_nothing_and_feeds_the_grinding_model(scene, tmp_
     import sys
     from yade import O
     from yadebreak.jobs import mill
-    from yadebreak.studies.grinding.spectra import read_spectra
+    from yadebreak.model.spectra import read_spectra
     brk, summary = mill.run(_args(tmp_path, breakage=False, vtk_interval=0.0), quiet=True)
     assert summary["breakage"] is False and summary["end_reason"] == "finished"
     assert summary["breakage_events"] == summary["damage_events"] == 0

@@ -29,6 +29,8 @@ MOVED = {
     "yadebreak.tools.bed_report": "yadebreak.studies.bed_report",
     "yadebreak.tools.calibration": "yadebreak.studies.calibration",
     "yadebreak.tools.grinding": "yadebreak.studies.grinding",
+    "yadebreak.studies.grinding.spectra": "yadebreak.model.spectra",
+    "yadebreak.studies.grinding.capture": "yadebreak.model.capture",
     "yadebreak.tools": "yadebreak.studies",
     "yadebreak.runs.verify": "yadebreak.studies.verify",
     "yadebreak.runs.job_options": "yadebreak.jobs.options",

@@ -25,10 +25,10 @@ from scipy.spatial import cKDTree
 
 from yadebreak.model import bonds
 from yadebreak.jobs import paraview
-from yadebreak.adapter.yade_api import O, utils
 from yadebreak.engine.parts import bonds as bonded
 from yadebreak.engine.parts.bonds import WATCH_LEVEL, agglomerate_scene
 from yadebreak.engine.scene import run_steps
+from yadebreak.scenes import view
 from yadebreak.jobs import skeleton
 from yadebreak.jobs.lifecycle import resume_arguments
 
@@ -95,7 +95,7 @@ class Agglomerate(skeleton.Job):
     def build(self):
         args, began = self.args, time.time()
         self.material, self.packing = build(args)
-        O.reset()
+        view.reset()
         self.scene = agglomerate_scene(self.material, self.packing, seed=args.seed,
                                        speed=args.speed,
                                        time_step_fraction=args.time_step_fraction,
@@ -103,7 +103,7 @@ class Agglomerate(skeleton.Job):
         bonds_initial = len(self.scene.watch.mode)
         self.say(f"{args.particles} spheres in a {2e3 * self.packing.mould_radius:.1f} mm mould, "
                  f"{bonds_initial} bonds ({2 * bonds_initial / args.particles:.2f} per sphere), "
-                 f"dt {O.dt:.3g} s, built in {time.time() - began:.1f} s")
+                 f"dt {view.time_step():.3g} s, built in {time.time() - began:.1f} s")
         self.loop = {"series": [], "runtime_s": 0.0, "impact_s": 0.0, "renew_at": 0}
 
     def resume(self, path):
@@ -114,8 +114,8 @@ class Agglomerate(skeleton.Job):
         self.scene.impact_seconds = self.loop["impact_s"]
         self.material = material_of(self.args)
         self.say(f"resumed from {path} at t = {self.loop['series'][-1]['time_ms']:.4f} ms "
-                 f"after the touch, iteration {O.iter}, {self.scene.watch.broken_count()} bonds "
-                 "broken")
+                 f"after the touch, iteration {view.iteration()}, "
+                 f"{self.scene.watch.broken_count()} bonds broken")
         return self.loop["runtime_s"]
 
     def open(self):
@@ -134,25 +134,26 @@ class Agglomerate(skeleton.Job):
         args, scene, packing, loop = self.args, self.scene, self.packing, self.loop
         watch, series = scene.watch, loop["series"]
         if self.began is None:
-            self.chunk = max(1, int(round(args.sample_interval / O.dt)))
+            self.chunk = max(1, int(round(args.sample_interval / view.time_step())))
             if watch.touch_time is None:      # to the first touch: the impact's t = 0
                 while watch.touch_time is None:
                     run_steps(1)
-                    if O.time > 1.0:
+                    if view.now() > 1.0:
                         raise RuntimeError("the agglomerate never reached the plane in 1 s")
                 series.append(_sample(scene, packing))
             self.began, self.impact_before = time.time(), scene.impact_seconds
         self.renewed = False
-        if not O.time - watch.touch_time < args.duration - 0.5 * O.dt:
+        now, dt = view.now(), view.time_step()
+        if not now - watch.touch_time < args.duration - 0.5 * dt:
             return "finished"
-        left = int(math.ceil((args.duration - (O.time - watch.touch_time)) / O.dt - 1e-9))
+        left = int(math.ceil((args.duration - (now - watch.touch_time)) / dt - 1e-9))
         run_steps(min(self.chunk, max(left, 1)))
         series.append(_sample(scene, packing))
         self.frames()
         scene.impact_seconds = self.impact_before + time.time() - self.began
-        if O.iter >= loop["renew_at"]:
+        if view.iteration() >= loop["renew_at"]:
             bonded.renew_contacts()
-            loop["renew_at"] = O.iter + RENEW_STEPS
+            loop["renew_at"] = view.iteration() + RENEW_STEPS
             self.renewed = True
         return None
 
@@ -160,7 +161,7 @@ class Agglomerate(skeleton.Job):
         return self.renewed
 
     def elapsed(self):
-        return O.time
+        return view.now()
 
     def status(self):
         row = self.loop["series"][-1]
@@ -209,21 +210,20 @@ def _sample(scene, packing):
     """One row of the time series (SERIES_FIELDS)."""
     watch = scene.watch
     damage = watch.damage_ratios()
-    return {"time_ms": (O.time - watch.touch_time) * 1e3,
+    return {"time_ms": (view.now() - watch.touch_time) * 1e3,
             "damage_ratio": float(np.nanmean(damage)),
             "broken_tension": watch.broken_count(bonds.TENSION),
             "broken_shear": watch.broken_count(bonds.SHEAR),
             "broken_compression": watch.broken_count(bonds.COMPRESSION),
             "above80_tension": int(watch.above[0]), "above80_shear": int(watch.above[1]),
             "above80_compression": int(watch.above[2]),
-            "kinetic_energy_J": float(utils.kineticEnergy()),
+            "kinetic_energy_J": view.kinetic_energy(),
             "debris_spheres": debris_count(watch, _positions(scene.sphere_ids),
                                            2.0 * float(packing.radii.mean()))}
 
 
 def _positions(ids):
-    bodies = O.bodies
-    return np.array([tuple(bodies[int(i)].state.pos) for i in ids])
+    return np.array([view.position(int(i)) for i in ids])
 
 
 def debris_count(watch, positions, mean_diameter):
@@ -352,8 +352,8 @@ def _outputs(args, out, material, packing, scene, series, runtime_s, end_reason,
         "bonds_broken_compression": watch.broken_count(bonds.COMPRESSION),
         "damage_ratio": float(np.nanmean(damage)),
         "radius_multiplier": material.binder.radius_multiplier,
-        "speed": args.speed, "seed": args.seed, "time_step": O.dt,
-        "duration": args.duration, "steps": int(O.iter),
+        "speed": args.speed, "seed": args.seed, "time_step": view.time_step(),
+        "duration": args.duration, "steps": int(view.iteration()),
         "fragments": {"count": int(len(counts)),
                       "largest_mass_fraction": float(fragment_mass[order[0]] / total),
                       "single_spheres": int(np.count_nonzero(counts == 1)),

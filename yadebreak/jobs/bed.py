@@ -10,7 +10,8 @@ import numpy as np
 from yadebreak import engine, scenes
 from yadebreak.jobs import paraview
 from yadebreak.scenes import poured_bed
-from yadebreak.adapter.yade_api import O
+from yadebreak.scenes import view
+from yadebreak.scenes.view import finest_sphere_size
 from yadebreak.jobs import skeleton
 from yadebreak.jobs.lifecycle import resume_arguments, write_atomic
 from yadebreak.jobs import options as job_options
@@ -49,13 +50,6 @@ def _options(args, out):
 def _bed_cache(given):
     """--bed-cache: "" the default folder, "off" none."""
     return None if given == "off" else given
-
-
-def finest_sphere_size():
-    """Diameter (m) of the smallest sphere in the scene (a pass over the bodies: once, at the end)."""
-    from yadebreak.adapter.yade_api import wrapper
-    return min((2.0 * b.shape.radius for b in O.bodies
-                if b is not None and isinstance(b.shape, wrapper.Sphere)), default=float("nan"))
 
 
 def why_it_took_longer(summary):
@@ -104,43 +98,44 @@ class BedImpact(skeleton.Job):
         self.say(f"{len(self.info['particles'])} particles of {args.material} "
                  f"({1e3 * args.size:g} mm), {args.layers} layer(s); ball at "
                  f"{self.info['speed']:.3f} m/s ({energy:g} J, {energy / mass:.0f} J per kg of "
-                 f"bed); dt {O.dt:.3g} s")
-        self.loop = {"touched": None, "turned": None, "initial_mass": mass, "initial_dt": O.dt}
+                 f"bed); dt {view.time_step():.3g} s")
+        self.loop = {"touched": None, "turned": None, "initial_mass": mass,
+                     "initial_dt": view.time_step()}
 
     def resume(self, path):
         self.brk, data = skeleton.load_checked(path, engine.load_checkpoint, self.args)
         self.info, self.loop = data["info"], data["loop"]
         self.info["centers"] = np.array(self.info["centers"])
         self.loop["wall_before_s"] = self.loop.get("wall_s", 0.0)   # all invocations
-        self.say(f"resumed from {path} at t = {1e3 * O.time:.3f} ms, iteration {O.iter}")
+        self.say(f"resumed from {path} at t = {1e3 * view.now():.3f} ms, "
+                 f"iteration {view.iteration()}")
         return self.loop["wall_before_s"]
 
     def open(self):
         self.frames = _paraview(self.args, self.out, self.brk, self.info)
-        self.ball = O.bodies[self.info["ball"]]
 
     def advance(self):
         loop, info = self.loop, self.info
         if loop["touched"] is None:           # the bed's motion before the ball reaches it
             before_touch = poured_bed.kinetic_energy(info["particles"])
         engine.run_steps(100 if loop["touched"] is None else 400)
-        if loop["touched"] is None and any(O.interactions.withBody(info["ball"])):
-            loop["touched"] = O.time
+        if loop["touched"] is None and view.touching(info["ball"]):
+            loop["touched"] = view.now()
             loop["bed_kinetic_energy_at_touch"] = before_touch
             scenes.hold_release(info)
         loop["chunks"] = loop.get("chunks", 0) + 1
         if self.at_safe_point():          # saved and loaded back where a checkpoint may be
             self.brk = self.frames.brk = engine.reload()     # taken: resumed from one, a run
-            self.ball = O.bodies[info["ball"]]                  # goes on as this one, bit for bit
+            #                                                   goes on as this one, bit for bit
         self.frames()                             # a frame if one is due (before the checkpoint)
-        vz = self.ball.state.vel[2]
+        vz = view.velocity(self.info["ball"])[2]
         if loop["touched"] is not None and loop["turned"] is None and vz >= 0.0:
-            loop["turned"] = O.time            # deepest penetration: loading is over
+            loop["turned"] = view.now()            # deepest penetration: loading is over
         # breakage happens while loading: after the turn, a short unloading, then open events
         # are closed with their largest energy (brk.finish)
-        if loop["turned"] is not None and O.time >= loop["turned"] + TAIL:
+        if loop["turned"] is not None and view.now() >= loop["turned"] + TAIL:
             return "finished"
-        if O.time > self.args.max_time:
+        if view.now() > self.args.max_time:
             self.say(f"stopped at max_time = {self.args.max_time} s of simulated time")
             return "time_limit"
         return None
@@ -150,20 +145,20 @@ class BedImpact(skeleton.Job):
         return self.loop.get("chunks", 0) % SAFE_EVERY == 0
 
     def elapsed(self):
-        return O.time
+        return view.now()
 
     def status(self):
-        vz = self.ball.state.vel[2]
-        return (f"t = {1e3 * O.time:.3f} ms, {len(self.brk.breakage_events)} breakages, "
-                f"{sum(1 for b in O.bodies if b is not None)} bodies, ball {vz:+.3f} m/s")
+        vz = view.velocity(self.info["ball"])[2]
+        return (f"t = {1e3 * view.now():.3f} ms, {len(self.brk.breakage_events)} breakages, "
+                f"{view.body_count()} bodies, ball {vz:+.3f} m/s")
 
     def done(self):
         touched, turned = self.loop["touched"], self.loop["turned"]
         if touched is None:
             return 0.0
         if turned is None:
-            return 0.5 * (1 - max(-self.ball.state.vel[2], 0.0) / self.info["speed"])
-        return 0.5 + 0.5 * (O.time - turned) / TAIL
+            return 0.5 * (1 - max(-view.velocity(self.info["ball"])[2], 0.0) / self.info["speed"])
+        return 0.5 + 0.5 * (view.now() - turned) / TAIL
 
     def save(self, path, wall_s):
         """The scene, the loop's own state (with the run's wall time so far) and the run's
@@ -229,8 +224,9 @@ def _report(brk, info, loop, args, out, energy, runtime, end_reason, end_message
         "damage_events": sum(1 for e in brk.events if e["kind"] == "damage"),
         "particles_broken": fates.count("broken"), "particles_damaged": fates.count("damaged"),
         "energy_per_bed_mass": energy / initial_mass,
-        "simulated_time": O.time, "steps": O.iter, "initial_dt": loop.get("initial_dt"),
-        "final_dt": O.dt, "finest_sphere_size": finest_sphere_size(), "runtime_s": runtime,
+        "simulated_time": view.now(), "steps": view.iteration(),
+        "initial_dt": loop.get("initial_dt"), "final_dt": view.time_step(),
+        "finest_sphere_size": finest_sphere_size(), "runtime_s": runtime,
         "wall_time_read_s": brk.wall_time["read"], "wall_time_replace_s": brk.wall_time["replace"],
         "end_reason": end_reason, "end_message": end_message,
     }

@@ -5,7 +5,7 @@ or event; total mass (spheres plus ledger) conserved to 1e-9; no fragment leavin
 parent's rigid velocity field (|v| + 2 |w| r, recorded per event); no kinetic energy created (no
 gravity in these scenes: the contact law only stores and dissipates); and the run ending. Used by
 scripts/extremes.py (the full matrix, a table) and tests/test_extremes.py (a fast subset).
-Coupling layer: imports yade through the scene builders.
+YADE is reached through the scenes (scenes/extremes.py, scenes/view.py).
 """
 from __future__ import annotations
 
@@ -20,8 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak import engine, scenes
-from yadebreak.engine import add_materials, attach
-from yadebreak.adapter.yade_api import O, utils
+from yadebreak.engine import attach
+from yadebreak.scenes import extremes as extreme_scenes, view
 from yadebreak.model.materials import load_material
 from yadebreak.jobs.lifecycle import mark_finished, progress
 
@@ -48,14 +48,6 @@ def _impact(size=SIZE, speed=20.0, material=None, **options):
         return scenes.impact_scene(material or _material(), size, [speed] * n, seed=4,
                                    dummies="ledger", **options)
     return build
-
-
-def _ore_scene():
-    """A fresh scene with the ore and steel materials; returns (Ip2 functor, ore Material)."""
-    O.reset()
-    ore = _material()
-    ip2, _ = add_materials({"ore": ore, "steel": "steel"})
-    return ip2, ore
 
 
 def _set_fracture_energy(brk, ids, energy):
@@ -85,19 +77,13 @@ def _break_now(ratio, size=SIZE):
     return build
 
 
+
+
 def _head_on(n):
     """Pairs of touching, identical particles (same fracture energy) fired at each other: both
     break in the same step, each touching the other."""
-    ip2, ore = _ore_scene()
-    r = SIZE / 2.0
-    ids = []
-    for k in range(n):
-        y = 4 * SIZE * k
-        for sign in (-1.0, 1.0):
-            b = utils.sphere((sign * r * 1.001, y, 0.0), r, material="ore")
-            b.state.vel = (-sign * 15.0, 0.0, 0.0)
-            ids.append(O.bodies.append(b))
-    O.engines = scenes.hertz_engines(ip2)
+    ore = _material()
+    ids = extreme_scenes.head_on_pairs(ore, SIZE, n, speed=15.0)
     brk = attach({"ore": ore}, seed=4, dummies="ledger")
     _set_fracture_energy(brk, ids, 30.0)
     return brk, ids
@@ -106,21 +92,8 @@ def _head_on(n):
 def _in_facet_corner(n):
     """Particles resting in a corner of a wall and two facets (a floor and a side) broken at once:
     fragments placed against a wall and facets."""
-    ip2, ore = _ore_scene()
-    r = SIZE / 2.0
-    ids = []
-    for k in range(n):
-        x0 = 4 * SIZE * k
-        floor = utils.facet([(x0 - SIZE, -SIZE, 0), (x0 + SIZE, -SIZE, 0), (x0, SIZE, 0)],
-                            material="steel")
-        side = utils.facet([(x0 - SIZE, -r, -SIZE), (x0 + SIZE, -r, -SIZE), (x0, -r, 2 * SIZE)],
-                           material="steel")
-        O.bodies.append([floor, side])
-        ids.append(O.bodies.append(utils.sphere((x0, 0.0, r), r, material="ore")))
-    O.bodies.append(utils.wall(-4 * SIZE, axis=0, sense=1, material="steel"))
-    b = O.bodies[ids[0]]
-    b.state.pos = (-4 * SIZE + r, 0.0, r)          # the first one touches the wall as well
-    O.engines = scenes.hertz_engines(ip2, facets=True)
+    ore = _material()
+    ids = extreme_scenes.in_facet_corner(ore, SIZE, n)
     brk = attach({"ore": ore}, seed=4, dummies="ledger")
     engine.run_steps(1)                          # contacts exist before the breakage
     for i in ids:
@@ -159,22 +132,8 @@ def cases():
 
 
 def _kinetic(brk):
-    total = 0.0
-    for b in O.bodies:
-        if b is not None and b.dynamic:
-            total += 0.5 * b.state.mass * b.state.vel.squaredNorm()
-            total += 0.5 * b.state.inertia[0] * b.state.angVel.squaredNorm()
-    return total + brk.ledger.kinetic_energy()   # ledger fines carry their momentum
-
-
-def _finite():
-    for b in O.bodies:
-        if b is not None:
-            s = b.state
-            if not (np.all(np.isfinite(s.pos)) and np.all(np.isfinite(s.vel))
-                    and np.all(np.isfinite(s.angVel))):
-                return False
-    return True
+    return view.moving_kinetic_energy() + brk.ledger.kinetic_energy()   # ledger fines carry
+    #                                                                     their momentum
 
 
 def run_case(case, fast=False):
@@ -196,7 +155,7 @@ def run_case(case, fast=False):
         engine.run_steps(500)
         steps += 500
         now = _kinetic(brk)
-        if O.interactions.countReal() == 0 or abs(now - last) <= 1e-6 * last + 1e-15:
+        if view.real_contacts() == 0 or abs(now - last) <= 1e-6 * last + 1e-15:
             ended = True
             break
         last = now
@@ -210,7 +169,7 @@ def run_case(case, fast=False):
     result = {
         "case": case.name, "particles": n, "steps": steps, "ended": bool(ended),
         "breakages": len(breakages), "max_breakages_one_step": max(per_step.values(), default=0),
-        "finite": bool(_finite() and finite_events),
+        "finite": bool(view.all_finite() and finite_events),
         "mass_error": abs(brk.total_mass() - mass_before) / mass_before,
         "fragment_speed_excess": max((e.get("fragment_speed_excess", -math.inf)
                                       for e in breakages), default=-math.inf),

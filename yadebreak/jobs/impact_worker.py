@@ -22,7 +22,7 @@ pool, worker, package = Path(sys.argv[1]), sys.argv[2], sys.argv[3]
 sys.path.insert(0, package)
 
 from yadebreak import scenes  # noqa: E402
-from yadebreak.adapter.yade_api import close_remote_access  # noqa: E402
+from yadebreak.scenes.view import close_remote_access  # noqa: E402
 from yadebreak.scenes.impact_pool import claim  # noqa: E402
 
 #: how often an idle worker looks at the queue (s)

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak import engine, scenes
-from yadebreak.adapter.yade_api import O
+from yadebreak.scenes import view
 from yadebreak.analysis import reports
 from yadebreak.model.materials import load_material
 from yadebreak.jobs import skeleton
@@ -133,9 +133,9 @@ def _drop_at(args, mat, steel, k, energy, out):
         **job_options.attach_options("drop_weight", args))
     initial_mass = brk.total_mass()
     # until every striker rebounds (or max_time of simulated time); then open events close
-    while any(O.bodies[s].state.vel[2] < 0 for s in strikers) and O.time < args.max_time:
+    while any(view.velocity(s)[2] < 0 for s in strikers) and view.now() < args.max_time:
         engine.run_steps(500)
-    stopped = any(O.bodies[s].state.vel[2] < 0 for s in strikers)
+    stopped = any(view.velocity(s)[2] < 0 for s in strikers)
     brk.finish()
     result = reports.breakage_result(brk, ids, mat, args.size, energy, steel)
     result["mass_relative_error"] = abs(brk.total_mass() - initial_mass) / initial_mass
@@ -170,7 +170,7 @@ class Repeated(skeleton.Job):
             self.mat, args.size, [self.speed] * args.particles, target=args.target,
             seed=args.seed, **job_options.attach_options(
                 "repeated_impact", args, event_log=str(self.out / "events.jsonl")))
-        self.home = {i: tuple(O.bodies[i].state.pos) for i in self.ids}
+        self.home = {i: view.position(i) for i in self.ids}
         self.alive = list(self.ids)
         self.fractions = []
 

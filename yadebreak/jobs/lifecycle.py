@@ -11,7 +11,6 @@ import hashlib
 import json
 import math
 import os
-import re
 import signal
 import sys
 import time
@@ -23,6 +22,11 @@ from pathlib import Path
 from yadebreak.model.intervals import InputError
 
 from yadebreak.options.flags import debugging, fail, script_option_names
+from yadebreak.process.errors import _first_line, disk_full, error_line  # noqa: F401
+from yadebreak.process.files import append_whole, save_figure, write_atomic, write_whole  # noqa: F401
+from yadebreak.process.signals import (  # noqa: F401
+    _STOP, Interrupted, _catch_signals, _on_signal, _restore_signals, _signal_name, stop_point,
+    stop_points, stop_requested)
 
 class ScriptError(InputError):
     """A user's mistake that a script reports in one line (exit code 2), e.g. a resume with other
@@ -88,10 +92,10 @@ def run_script(main, *args):
 
 def close_remote_access():
     """Under the `yade` launcher (which imports yade.remote to start them): close its Python
-    prompt and XMLRPC servers, which listen on every interface (coupling.yade_api's
+    prompt and XMLRPC servers, which listen on every interface (scenes.view's
     close_remote_access). Nothing to do under /usr/bin/python3."""
     if "yade.remote" in sys.modules:
-        from yadebreak.adapter.yade_api import close_remote_access as close
+        from yadebreak.scenes.view import close_remote_access as close
         close()
 
 
@@ -99,30 +103,6 @@ def _end_interrupted(exc, out, began):
     progress(f"interrupted ({_signal_name(getattr(exc, 'signum', signal.SIGINT))}): "
              f"{kept_outputs(out, began)}")
     raise SystemExit(getattr(exc, "exit_code", 128 + signal.SIGINT)) from None
-
-
-def _first_line(exc):
-    lines = str(exc).strip().splitlines()
-    return lines[0] if lines else ""
-
-
-def error_line(exc):
-    """An error in one line: a full disk as its OSError (YADE wraps an error raised in a PyRunner
-    in a RuntimeError of several lines), anything else as 'Type: first line'."""
-    if disk_full(exc):
-        if isinstance(exc, OSError):
-            return f"OSError: {exc}"
-        found = re.search(r"\[Errno (?:28|122)\][^\n]*", str(exc))
-        return f"OSError: {found.group(0).strip()}" if found else _first_line(exc)
-    return f"{type(exc).__name__}: {_first_line(exc)}"
-
-
-def disk_full(exc):
-    """True if `exc` is a full disk or an exceeded quota (ENOSPC, EDQUOT), also when YADE has
-    wrapped it in a PyRunner's RuntimeError."""
-    if isinstance(exc, OSError) and exc.errno in (errno.ENOSPC, errno.EDQUOT):
-        return True
-    return isinstance(exc, RuntimeError) and bool(re.search(r"\[Errno (?:28|122)\]", str(exc)))
 
 
 # -- one run per output folder ---------------------------------------------------------------------
@@ -255,93 +235,6 @@ def claim_out(out, args, found):
         (Path(out) / name).unlink(missing_ok=True)
 
 
-# -- signals: SIGINT and SIGTERM end a run as 'interrupted' ----------------------------------------
-class Interrupted(KeyboardInterrupt):
-    """SIGINT (Ctrl-C) or SIGTERM: the run ends as 'interrupted', exit code 128 + the signal's
-    number; `note` adds to its end message (a checkpoint that could not be written)."""
-
-    def __init__(self, signum=signal.SIGINT, note=""):
-        super().__init__(int(signum))
-        self.signum, self.note = int(signum), note
-
-    @property
-    def exit_code(self):
-        return 128 + self.signum
-
-    @property
-    def end_message(self):
-        return f"stopped by {_signal_name(self.signum)}{self.note}"
-
-
-def _signal_name(signum):
-    return "Ctrl-C, SIGINT" if signum == signal.SIGINT else signal.Signals(signum).name
-
-
-_STOP = {"signal": None, "points": 0}    # the signal received; depth of stop_points blocks
-
-
-def _on_signal(signum, frame):
-    first = _STOP["signal"] is None
-    _STOP["signal"] = signum
-    if _STOP["points"] and first:
-        return                           # the job's loop stops at its next stop_point
-    raise Interrupted(signum)
-
-
-def _catch_signals():
-    """SIGINT and SIGTERM to _on_signal while a script runs; returns the handlers to restore
-    (none outside the main thread, where Python cannot set them)."""
-    import threading
-    _STOP["signal"] = None
-    if threading.current_thread() is not threading.main_thread():
-        return {}
-    handlers = {}
-    for s in (signal.SIGINT, signal.SIGTERM):
-        handlers[s] = signal.getsignal(s)
-        signal.signal(s, _on_signal)
-    return handlers
-
-
-def _restore_signals(handlers):
-    for s, handler in handlers.items():
-        signal.signal(s, signal.SIG_DFL if handler is None else handler)
-    _STOP["signal"] = None
-
-
-@contextmanager
-def stop_points():
-    """Within the block, SIGINT or SIGTERM only asks the run to stop: the job's loop stops at its
-    next stop_point(), between its chunks of steps, where its state is whole (a signal handled
-    where it strikes could land in a PyRunner, halfway through a breakage, and come out as YADE's
-    PyRunner error). A second signal stops at once."""
-    _STOP["points"] += 1
-    try:
-        yield
-    finally:
-        _STOP["points"] -= 1
-
-
-def stop_requested():
-    """True once SIGINT or SIGTERM has been received by run_script's handlers."""
-    return _STOP["signal"] is not None
-
-
-def stop_point(save=None):
-    """Where a job's loop may stop (see stop_points): after SIGINT or SIGTERM, save() (the
-    checkpoint), then raise Interrupted. A save that fails (a full disk) is said in the end
-    message; the run still ends as interrupted."""
-    signum = _STOP["signal"]
-    if signum is None:
-        return
-    note = ""
-    if save is not None:
-        try:
-            save()
-        except OSError as exc:
-            note = f"; the checkpoint could not be written ({error_line(exc)})"
-    raise Interrupted(signum, note=note)
-
-
 # -- what a run leaves -----------------------------------------------------------------------------
 CHECKPOINT = "checkpoint.yade.gz"
 PARTIAL = "partial.json"
@@ -377,52 +270,11 @@ def kept_outputs(out, since):
     return text + ("" if wrote_summary else "; no summary.json was written")
 
 
-def append_whole(path, text):
-    """Append `text` to `path` whole or not at all: a write that fails (a full disk) cuts the
-    file back to its size before (cutting needs no space), then the error goes on."""
-    path = Path(path)
-    size = path.stat().st_size if path.exists() else 0
-    try:
-        with open(path, "a") as f:
-            f.write(text)
-    except OSError:
-        if path.exists():
-            os.truncate(path, size)
-        raise
-
-
 def run_wall_time(loop, start):
     """Wall time (s) of a checkpointed run over all its invocations: those before this one (up to
     their last checkpoint: the rest was simulated again), kept by --resume in
     loop["wall_before_s"], and this one since `start` (time.time())."""
     return loop.get("wall_before_s", 0.0) + time.time() - start
-
-
-def write_atomic(path, text):
-    """Write `text` to `path` whole or not at all (write_whole)."""
-    write_whole(path, lambda tmp: tmp.write_text(text))
-
-
-def write_whole(path, write):
-    """write(tmp) to a temporary file beside `path`, then os.replace: `path` holds the old
-    content or the new, never part of it (a full disk, a kill); the temporary file is removed if
-    the write fails."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
-def save_figure(fig, path, **options):
-    """fig.savefig(path, **options) whole or not at all (write_whole; the format from the
-    path's suffix)."""
-    path = Path(path)
-    write_whole(path, lambda tmp: fig.savefig(tmp, format=path.suffix.lstrip(".") or None,
-                                              **options))
 
 
 def read_checkpoint(path, load):

@@ -16,93 +16,17 @@ import math
 
 import numpy as np
 
-from yadebreak import engine, scenes
+from yadebreak import engine
 from yadebreak.model import milling
 from yadebreak.jobs import paraview
-from yadebreak.adapter.yade_api import O, utils, wrapper as _w
-from yadebreak.engine.stepping import smallest_rayleigh_time
+from yadebreak.scenes import view
+from yadebreak.scenes.mill import (  # noqa: F401 (the job's names of its scene)
+    PACKING, SETTLE_TIME, charge_counts, charge_positions, charge_state, drum_facets, drum_profile,
+    drum_torque, end_walls, mill_scene, mill_time)
 from yadebreak.jobs import skeleton
 from yadebreak.jobs import options as job_options
 from yadebreak.jobs.options import check_mill_geometry
 from yadebreak.jobs.lifecycle import ScriptError, resume_arguments, write_atomic
-
-PACKING = 0.6                    # solid fraction of a settled charge (bulk volume -> solid volume)
-SETTLE_TIME = 0.25               # s of settling under gravity, drum still, before the engine
-
-
-# -- geometry ---------------------------------------------------------------------------------------
-def drum_profile(radius, lifters, lifter_height, lifter_width, segments=48):
-    """The drum's cross-section (y, z points, m): a circle of `segments` chords with `lifters`
-    rectangular bars (height and width in m) standing inward, evenly spaced, closed."""
-    half = 0.5 * lifter_width / radius              # half the angle a lifter's foot spans
-    points = []
-    for k in range(segments):
-        theta0, theta1 = 2 * math.pi * k / segments, 2 * math.pi * (k + 1) / segments
-        points.append((radius * math.cos(theta0), radius * math.sin(theta0)))
-        for j in range(lifters):
-            at = 2 * math.pi * (j + 0.5) / lifters
-            if theta0 <= at < theta1:
-                inner = radius - lifter_height
-                for angle, r in ((at - half, radius), (at - half, inner), (at + half, inner),
-                                 (at + half, radius)):
-                    points.append((r * math.cos(angle), r * math.sin(angle)))
-    return points + [points[0]]
-
-
-def drum_facets(profile, length, material):
-    """Facets of the drum's shell: two per chord of the profile, between x = -length/2 and
-    length/2. The end walls are planes (end_walls): a fan of thin facets from the axis gave NaN
-    contacts with YADE 2023.02's facet geometry (measured: a ball at the end wall's centre)."""
-    x0, x1 = -0.5 * length, 0.5 * length
-    facets = []
-    for (ya, za), (yb, zb) in zip(profile[:-1], profile[1:]):
-        a0, b0, a1, b1 = (x0, ya, za), (x0, yb, zb), (x1, ya, za), (x1, yb, zb)
-        facets += [utils.facet((a0, b0, b1), material=material),
-                   utils.facet((a0, b1, a1), material=material)]
-    return facets
-
-
-def end_walls(length, material):
-    """The drum's two end walls, planes x = -length/2 and x = length/2, still (their friction on
-    the charge is the only difference from walls that turn with the shell)."""
-    return [utils.wall(-0.5 * length, axis=0, sense=1, material=material),
-            utils.wall(0.5 * length, axis=0, sense=-1, material=material)]
-
-
-def charge_positions(radius, length, clearance, ball_size, balls, ore_size, ores, rng):
-    """Centres (m) of `balls` balls and `ores` ore particles, as low in the drum as they go: the
-    lowest points of a jittered lattice inside the drum (at least `clearance` from the shell), the
-    balls first, then the ore among them without overlap. Raises ScriptError if they do not fit."""
-    def lattice(size):
-        step = 1.02 * size
-        reach = radius - clearance - 0.5 * size
-        xs = np.arange(-0.5 * length + 0.51 * size, 0.5 * length - 0.51 * size + 1e-12, step)
-        ys = np.arange(-reach, reach + 1e-12, step)
-        grid = np.array(np.meshgrid(xs, ys, ys, indexing="ij")).reshape(3, -1).T
-        inside = np.hypot(grid[:, 1], grid[:, 2]) <= reach
-        grid = grid[inside]
-        return grid[np.lexsort((rng.random(len(grid)), grid[:, 2]))]     # lowest first
-    ball_at = lattice(ball_size)[:balls]
-    ore_at = lattice(ore_size)
-    if len(ore_at) and len(ball_at):
-        gap = np.min(np.linalg.norm(ore_at[:, None, :] - ball_at[None, :, :], axis=2), axis=1)
-        ore_at = ore_at[gap > 0.51 * (ball_size + ore_size)]
-    ore_at = ore_at[:ores]
-    if len(ball_at) < balls or len(ore_at) < ores:
-        raise ScriptError(f"the charge does not fit: {len(ball_at)} of {balls} balls and "
-                          f"{len(ore_at)} of {ores} ore particles placed; lower --ball-filling or "
-                          "--ore-filling, or use a larger drum")
-    return ball_at, ore_at
-
-
-def charge_counts(args):
-    """(balls, ore particles) for the fillings: a filling is the bulk volume of the charge over the
-    drum's volume; the bulk is PACKING solid."""
-    volume = math.pi * (0.5 * args.drum_diameter) ** 2 * args.drum_length
-    ball_volume = math.pi / 6 * args.ball_size ** 3
-    ore_volume = math.pi / 6 * args.size ** 3
-    return (max(1, round(args.ball_filling * volume * PACKING / ball_volume)),
-            max(1, round(args.ore_filling * volume * PACKING / ore_volume)))
 
 
 def check_geometry(args):
@@ -110,73 +34,6 @@ def check_geometry(args):
     problem = check_mill_geometry(args)
     if problem:
         raise ScriptError(problem)
-
-
-# -- the scene ----------------------------------------------------------------------------------------
-def mill_scene(args, options):
-    """Build the mill, settle the charge with the drum still, attach yadebreak and start the drum.
-    Returns (controller, info)."""
-    O.reset()
-    ip2, mats = engine.add_materials({"ore": args.material, "steel": "steel"},
-                                       stiffness_scale=args.stiffness_scale)
-    radius = 0.5 * args.drum_diameter
-    profile = drum_profile(radius, args.lifters, args.lifter_height, args.lifter_width)
-    drum = O.bodies.append(drum_facets(profile, args.drum_length, "steel"))
-    ends = O.bodies.append(end_walls(args.drum_length, "steel"))
-    n_balls, n_ore = charge_counts(args)
-    rng = np.random.default_rng(args.seed)
-    ball_at, ore_at = charge_positions(radius, args.drum_length, args.lifter_height,
-                                       args.ball_size, n_balls, args.size, n_ore, rng)
-    balls = [O.bodies.append(utils.sphere(tuple(c), 0.5 * args.ball_size, material="steel"))
-             for c in ball_at]
-    ore = [O.bodies.append(utils.sphere(tuple(c), 0.5 * args.size, material="ore"))
-           for c in ore_at]
-    speed = args.speed * milling.critical_speed(args.drum_diameter, args.ball_size)  # rev/s
-    omega = 2 * math.pi * speed
-    O.engines = scenes.hertz_engines(ip2, gravity=(0.0, 0.0, -9.81), facets=True) + [
-        _w.RotationEngine(rotationAxis=(1, 0, 0), rotateAroundZero=True, zeroPoint=(0, 0, 0),
-                          angularVelocity=0.0, ids=list(drum), label="drum")]
-    # settle with the drum still, damped, before anything is tracked (the fill is not milling)
-    O.dt = args.time_step_fraction * smallest_rayleigh_time()
-    newton = O.engines[-2]
-    newton.damping = 0.5
-    O.run(int(SETTLE_TIME / O.dt), True)
-    newton.damping = 0.0
-    for i in balls + ore:
-        O.bodies[i].state.vel = (0, 0, 0)
-        O.bodies[i].state.angVel = (0, 0, 0)
-    brk = engine.attach({"ore": args.material}, seed=args.seed, **options)
-    next(e for e in O.engines if isinstance(e, _w.RotationEngine)).angularVelocity = omega
-    info = {"drum": list(drum), "ends": list(ends), "balls": balls, "ore": ore, "omega": omega, "speed_rps": speed,
-            "start_time": O.time,                 # the settling's end: the mill's t = 0
-            "profile": profile, "ball_mass": sum(O.bodies[i].state.mass for i in balls)}
-    return brk, info
-
-
-def drum_torque(drum):
-    """Torque (N m) of the charge on the drum about its axis (x): sum over the drum's facets of
-    (position x force + torque), from the last step's forces."""
-    total = 0.0
-    for i in drum:
-        f, t, p = O.forces.f(i), O.forces.t(i), O.bodies[i].state.pos
-        total += p[1] * f[2] - p[2] * f[1] + t[0]
-    return total
-
-
-def mill_time(info):
-    """Simulated time (s) since the drum started (the settling before it is not milling)."""
-    return O.time - info["start_time"]
-
-
-def charge_state(info):
-    """(mass (kg), horizontal lever arm y of its centre of mass (m)) of every sphere in the drum:
-    balls, ore and fragments (a pass over the bodies, once per sample)."""
-    mass = moment = 0.0
-    for b in O.bodies:
-        if b is not None and b.dynamic:
-            mass += b.state.mass
-            moment += b.state.mass * b.state.pos[1]
-    return mass, (moment / mass if mass else 0.0)
 
 
 PAIR_TYPES = ("ball-ore", "ore-ore", "ore-liner")
@@ -257,7 +114,7 @@ class Mill(skeleton.Job):
     def build(self):
         args = self.args
         self.brk, self.info = mill_scene(args, _options(args, self.out))
-        self.loop = {"initial_mass": self.brk.total_mass(), "initial_dt": O.dt,
+        self.loop = {"initial_mass": self.brk.total_mass(), "initial_dt": view.time_step(),
                      "sieves": sieves_for(args).tolist(), "times": [], "passing": [],
                      "feed_mass": [], "charge_mass": [], "lever_arm": [], "torque_time": [],
                      "torque": [], "next_sample": 0.0}
@@ -265,7 +122,7 @@ class Mill(skeleton.Job):
                  f"{len(self.info['ore'])} particles of {args.material} ({1e3 * args.size:g} "
                  f"mm) in a {1e3 * args.drum_diameter:g} x {1e3 * args.drum_length:g} mm drum at "
                  f"{60 * self.info['speed_rps']:.1f} rpm ({100 * args.speed:g} % of critical); "
-                 f"dt {O.dt:.3g} s")
+                 f"dt {view.time_step():.3g} s")
 
     def resume(self, path):
         self.brk, data = skeleton.load_checked(
@@ -300,7 +157,7 @@ class Mill(skeleton.Job):
     def status(self):
         return (f"t = {mill_time(self.info):.3f} of {self.args.duration:g} s, "
                 f"{len(self.brk.breakage_events)} breakages, "
-                f"{sum(1 for b in O.bodies if b is not None)} bodies, dt {O.dt:.2g} s")
+                f"{view.body_count()} bodies, dt {view.time_step():.2g} s")
 
     def done(self):
         return mill_time(self.info) / self.args.duration
@@ -371,7 +228,7 @@ def _report(brk, info, loop, args, out, runtime, end_reason, end_message):
         "ore_filling": args.ore_filling, "stiffness_scale": args.stiffness_scale,
         "seed": args.seed, "balls": len(info["balls"]), "ore_particles": len(info["ore"]),
         "bodies_start": len(info["balls"]) + len(info["ore"]) + len(info["drum"]) + 2,
-        "bodies_end": sum(1 for b in O.bodies if b is not None),
+        "bodies_end": view.body_count(),
         "breakage_events": sum(e["kind"] == "breakage" for e in events),
         "damage_events": sum(e["kind"] == "damage" for e in events),
         "breakage": bool(getattr(args, "breakage", True)),
@@ -384,11 +241,24 @@ def _report(brk, info, loop, args, out, runtime, end_reason, end_message):
                                         in spectra.items()},
         "mean_power_W": mean_power, "torque_arm_power_W": torque_arm,
         "bond_power_W": bond, "ball_mass": info["ball_mass"],
-        "simulated_time": mill_time(info), "steps": O.iter, "initial_dt": loop["initial_dt"],
-        "final_dt": O.dt, "runtime_s": runtime,
+        "simulated_time": mill_time(info), "steps": view.iteration(),
+        "initial_dt": loop["initial_dt"], "final_dt": view.time_step(), "runtime_s": runtime,
         "throughput_s_per_hour": 3600.0 * mill_time(info) / runtime if runtime > 0 else None,
         "end_reason": end_reason, "end_message": end_message}
     write_atomic(out / "summary.json", json.dumps(summary, indent=2))
+    _write_histories(out, loop, power, edges, spectra)
+    if edges is not None and not summary["breakage"]:   # the spectra run: the grinding model's
+        _write_grinding_spectra(out)                      # input
+    _plots(out, summary, loop, info, power, edges, spectra)
+    return summary
+
+
+def _write_histories(out, loop, power, edges, spectra):
+    """The histories of a run as CSV: size distribution, feed class, power, and the collision
+    energy spectra (if the mill turned)."""
+    times, feed = np.array(loop["times"]), np.array(loop["feed_mass"])
+    ore_mass = loop["initial_mass"]
+    torque = np.array(loop["torque"])
     sieves = np.array(loop["sieves"])
     with open(out / "size_distribution.csv", "w", newline="") as f:
         w = csv.writer(f)
@@ -414,17 +284,12 @@ def _report(brk, info, loop, args, out, runtime, end_reason, end_message):
                 w.writerow([edges[k], edges[k + 1]] + [float(v) for kind in PAIR_TYPES
                                                        for v in (spectra[kind][0][k],
                                                                  spectra[kind][1][k])])
-        if not summary["breakage"]:            # the spectra run: the grinding model's input
-            _write_grinding_spectra(out)
-    _plots(out, summary, loop, info, power, edges, spectra)
-    return summary
 
 
 def _write_grinding_spectra(out):
     """spectra.csv for `python3 -m yadebreak grind` (docs/grinding.md, Section 2), from this
     run's summary.json and collision_spectra.csv."""
-    from yadebreak.studies.grinding.cli import SPECTRA_NAME
-    from yadebreak.studies.grinding.spectra import from_mill_run, write_spectra
+    from yadebreak.model.spectra import SPECTRA_NAME, from_mill_run, write_spectra
     write_spectra(out / SPECTRA_NAME, from_mill_run(out))
 
 
@@ -477,11 +342,11 @@ def _plots(out, summary, loop, info, power, edges, spectra):
     profile = [(c * y - s * z, s * y + c * z) for y, z in info["profile"]]
     ax.add_patch(Polygon(1e3 * np.array(profile), closed=True, fill=False, ec="k"))
     balls = set(info["balls"])
-    for b in O.bodies:
-        if b is not None and isinstance(b.shape, _w.Sphere):
-            colour = "0.55" if b.id in balls else "tab:orange"
-            ax.add_patch(Circle((1e3 * b.state.pos[1], 1e3 * b.state.pos[2]),
-                                1e3 * b.shape.radius, fc=colour, ec="k", lw=0.2, alpha=0.8))
+    spheres = view.spheres()
+    for i, pos, radius in zip(spheres.ids.tolist(), spheres.pos, spheres.radius.tolist()):
+        colour = "0.55" if i in balls else "tab:orange"
+        ax.add_patch(Circle((1e3 * pos[1], 1e3 * pos[2]), 1e3 * radius, fc=colour, ec="k",
+                            lw=0.2, alpha=0.8))
     reach = 550 * summary["drum_diameter"]
     ax.set(xlim=(-reach, reach), ylim=(-reach, reach), aspect="equal", xlabel="y (mm)",
            ylabel="z (mm)", title=f"charge at t = {mill_time(info):.2f} s (grey balls, orange ore)")

@@ -389,5 +389,5 @@ def read(job, description=None, argv=None):
 
 def _table_row(defaults):
     """A yade-batch row's values (yade-batch runs the script inside YADE)."""
-    from yadebreak.adapter.yade_api import table_row
-    return table_row(defaults)
+    from yadebreak.scenes.view import batch_row
+    return batch_row(defaults)

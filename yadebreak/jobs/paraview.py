@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from yadebreak.adapter.yade_api import O, wrapper
+from yadebreak.scenes import view
 from yadebreak.engine.state import NONE
 from yadebreak.jobs.lifecycle import write_atomic
 
@@ -77,7 +77,7 @@ class ParaviewSeries:
         self._surfaces = None             # ((points, polygons, ids), file) last written
         self.frames = []                  # (time, spheres file, surfaces file)
         if resume:
-            self._keep_frames_until(O.time)
+            self._keep_frames_until(view.now())
         else:
             self._remove_files(0)
         if not self.frames:
@@ -85,7 +85,7 @@ class ParaviewSeries:
 
     def __call__(self):
         """Write a frame if the next due time (see _next_due) has come; True if one was written."""
-        if O.time < self._next_due():
+        if view.now() < self._next_due():
             return False
         self.write_frame()
         return True
@@ -93,7 +93,7 @@ class ParaviewSeries:
     def close(self):
         """The last frame (unless one was written at this time). The .pvd indexes are complete
         after every frame: nothing else is left to close."""
-        if not self.frames or self.frames[-1][0] < O.time:
+        if not self.frames or self.frames[-1][0] < view.now():
             self.write_frame()
 
     def _next_due(self):
@@ -107,31 +107,24 @@ class ParaviewSeries:
         spheres = f"spheres_{k:04d}.vtp"
         write_atomic(self.folder / spheres, self._spheres_vtp())
         surfaces = self._surfaces_file()
-        self.frames.append((float(O.time), spheres, surfaces))
+        self.frames.append((float(view.now()), spheres, surfaces))
         write_atomic(self.folder / "spheres.pvd", _pvd([(t, s) for t, s, _ in self.frames]))
         write_atomic(self.folder / "surfaces.pvd", _pvd([(t, s) for t, _, s in self.frames]))
 
     # -- spheres ---------------------------------------------------------------------------------
     def _spheres_vtp(self):
-        ids, pos, vel, radius = [], [], [], []
-        for b in O.bodies:                # one pass over YADE's bodies; the rest is numpy
-            if b is not None and isinstance(b.shape, wrapper.Sphere):
-                ids.append(b.id)
-                pos.append(tuple(b.state.pos))
-                vel.append(tuple(b.state.vel))
-                radius.append(b.shape.radius)
-        ids = np.array(ids, dtype=np.int64)
-        arrays = [("id", ids, "Int64"), ("radius", np.array(radius, float), "Float64"),
-                  ("velocity", np.array(vel, float).reshape(-1, 3), "Float64")]
+        ids, pos, vel, radius = view.spheres()  # one pass over YADE's bodies; the rest is numpy
+        arrays = [("id", ids, "Int64"), ("radius", radius, "Float64"),
+                  ("velocity", vel, "Float64")]
         if self._sphere_arrays is not None:
             arrays += self._sphere_arrays(ids)
-            return _polydata(np.array(pos, float).reshape(-1, 3), arrays, "PointData")
+            return _polydata(pos, arrays, "PointData")
         columns = self._body_columns(ids)
         arrays += [("fracture_energy", columns["fracture_energy"], "Float64"),
                    ("damage", columns["damage"], "Float64"),
                    ("class", columns["class"], "Int32"),
                    ("generation", columns["generation"], "Int32")]
-        return _polydata(np.array(pos, float).reshape(-1, 3), arrays, "PointData")
+        return _polydata(pos, arrays, "PointData")
 
     def _body_columns(self, ids):
         """fracture_energy, damage, class and generation of bodies `ids` from the controller's
@@ -168,23 +161,16 @@ class ParaviewSeries:
     def _surface_geometry(self):
         """(points (n, 3), polygons as lists of point indices, body id of each polygon)."""
         points, polys, ids = [], [], []
-        for b in O.bodies:
-            if b is None:
-                continue
-            if isinstance(b.shape, wrapper.Facet):
-                corners = [b.state.pos + b.state.ori * v for v in b.shape.vertices]
-            elif isinstance(b.shape, wrapper.Wall):
-                corners = self._wall_corners(b)
-            else:
-                continue
+        for surface in view.surfaces():
+            corners = surface.corners if surface.corners is not None else \
+                self._wall_corners(surface.axis, surface.offset)
             polys.append(list(range(len(points), len(points) + len(corners))))
             points += [tuple(p) for p in corners]
-            ids.append(b.id)
+            ids.append(surface.id)
         return (np.array(points, float).reshape(-1, 3), polys, np.array(ids, np.int64))
 
-    def _wall_corners(self, wall):
-        """The wall's square patch (see wall_patch), in the wall's plane."""
-        axis = wall.shape.axis
+    def _wall_corners(self, axis, offset):
+        """A wall's square patch (see wall_patch), in its plane (normal `axis`, at `offset`)."""
         u, v = [a for a in range(3) if a != axis]
         if self._wall_patch is None:
             self._wall_patch = self._patch_size()
@@ -192,7 +178,7 @@ class ParaviewSeries:
         corners = []
         for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
             p = np.array(centre, float)
-            p[axis] = wall.state.pos[axis]
+            p[axis] = offset
             p[u] += su * half
             p[v] += sv * half
             corners.append(p)
@@ -201,13 +187,10 @@ class ParaviewSeries:
     def _patch_size(self):
         """(centre (3,), half side) of the walls' patches: the bounding box of yadebreak's spheres
         (all spheres if it knows none) with a margin."""
-        spheres = [(tuple(b.state.pos), b.shape.radius, b.id) for b in O.bodies
-                   if b is not None and isinstance(b.shape, wrapper.Sphere)]
-        if not spheres:
+        ids, pos, _, radius = view.spheres()
+        if not len(ids):
             return np.zeros(3), 1.0
-        pos = np.array([s[0] for s in spheres])
-        radius = np.array([s[1] for s in spheres])
-        known = self._body_columns(np.array([s[2] for s in spheres]))["class"] != NONE
+        known = self._body_columns(ids)["class"] != NONE
         if known.any():
             pos, radius = pos[known], radius[known]
         low, high = (pos - radius[:, None]).min(axis=0), (pos + radius[:, None]).max(axis=0)

@@ -5,6 +5,9 @@ impacts     particles shot at a target, repeated impacts, the drop weight; the s
 impact_pool YADE worker processes running impact scenes from a queue (no yade import here)
 beds        a ball on a bed of particles (lattice or poured)
 poured_bed  beds poured and settled under gravity, and their cache
+mill        the laboratory ball mill: drum, lifters, charge; its torque and charge state
+extremes    the stability matrix's pairs fired at each other and facet corners
+view        what a job reads of the running scene and asks of the YADE process
 """
 from yadebreak.scenes.beds import (BALL_DIAMETER, BALL_MASS, bed_impact_scene,  # noqa: F401
                    hex_bed_positions, hold_release)

@@ -42,6 +42,76 @@ def hex_bed_positions(size, rings, layers=1, gap=0.01):
 POUR_STREAM = 7
 
 
+@dataclasses.dataclass(frozen=True)
+class _BedPlan:
+    """What _build_bed makes (bed_impact_scene's arguments, resolved)."""
+    labels: dict                # YADE label -> material
+    overrides: dict             # rolling friction overrides per label pair
+    lattice: np.ndarray         # (n, 3) the lattice's centres (m)
+    holder_radius: float        # m
+    packing: str                # "poured" or "lattice"
+    layers: int
+    size: float                 # particle diameter (m)
+    seed: int
+    settle_steps: int           # lattice beds of several layers: damped settling steps
+    stiffness_scale: float
+    rolling: bool
+    say: object                 # say(message): progress of a pour
+
+
+def _build_bed(plan):
+    """The anvil, the holder and the bed (poured, or a lattice settled under damping); returns
+    ({anvil, particles, holder: ids}, the pour's record or None)."""
+    from yadebreak.scenes import poured_bed
+    size, layers, lattice, holder_radius = plan.size, plan.layers, plan.lattice, plan.holder_radius
+    O.reset()
+    ip2, _ = add_materials(plan.labels, stiffness_scale=plan.stiffness_scale)
+    table = rolling_friction(plan.labels, plan.overrides)[0] if plan.rolling else None
+    anvil = O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="steel"))
+    holder = []
+    if layers > 1:             # poured: the loose column's height, cut to the bed after
+        holder = _holder(holder_radius, lattice[:, 2].max() + size if plan.packing == "lattice"
+                         else 2.5 * (lattice[:, 2].max() + size))
+    O.engines = hertz_engines(ip2, gravity=(0.0, 0.0, -9.81), facets=bool(holder),
+                              rolling=table)
+    if plan.packing == "poured":
+        rng = np.random.default_rng(np.random.SeedSequence([int(plan.seed), POUR_STREAM]))
+        particles, settled = poured_bed.pour(len(lattice), size / 2.0, holder_radius, rng,
+                                             "ore", plan.say)
+        for i in holder:       # as the lattice's, half a size above the top particle,
+            O.bodies.erase(i)  # but clear of the ball that starts just above the bed
+        ball = BALL_DIAMETER / 2.0
+        clear = ball - math.sqrt(ball ** 2 - holder_radius ** 2)
+        holder = _holder(holder_radius, settled.height + min(size / 2.0, 0.9 * clear))
+    else:
+        particles = [O.bodies.append(utils.sphere(tuple(c), size / 2.0, material="ore"))
+                     for c in lattice]
+        settled = None
+        if layers > 1 and plan.settle_steps:    # settle the stack before anything is tracked
+            O.dt = 0.2 * utils.PWaveTimeStep()
+            newton = O.engines[3]
+            newton.damping = 0.4
+            O.run(plan.settle_steps, True)
+            newton.damping = 0.0
+            for i in particles:
+                O.bodies[i].state.vel = (0, 0, 0)
+                O.bodies[i].state.angVel = (0, 0, 0)
+    return {"anvil": anvil, "particles": particles, "holder": list(holder)}, settled
+
+
+def _drop_ball(top, gap, energy):
+    """The 88 mm steel ball (BALL_MASS) `gap` (m) above the bed's `top` (m), falling with the
+    speed of its drop for `energy` (J): returns (its id, speed (m/s))."""
+    ball_radius = BALL_DIAMETER / 2.0
+    ball = utils.sphere((0.0, 0.0, top + ball_radius + gap), ball_radius, material="steel")
+    ball.state.mass = BALL_MASS
+    inertia = 0.4 * BALL_MASS * ball_radius ** 2
+    ball.state.inertia = (inertia, inertia, inertia)
+    speed = math.sqrt(2.0 * energy / BALL_MASS)
+    ball.state.vel = (0.0, 0.0, -speed)
+    return O.bodies.append(ball), speed
+
+
 def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, energy=3.05,
                      seed=1, settle_steps=3000, packing=None, rolling=True,
                      steel_rolling_friction=None, bed_cache="", stiffness_scale=1.0,
@@ -72,65 +142,25 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
                           + 0.02 * size)
 
     mats = {"ore": _material(material), "steel": _material("steel")}   # (cache key, info)
-
-    def build():
-        O.reset()
-        ip2, _ = add_materials(labels, stiffness_scale=stiffness_scale)
-        table = rolling_friction(labels, overrides)[0] if rolling else None
-        anvil = O.bodies.append(utils.wall(0.0, axis=2, sense=1, material="steel"))
-        holder = []
-        if layers > 1:             # poured: the loose column's height, cut to the bed after
-            holder = _holder(holder_radius, lattice[:, 2].max() + size if packing == "lattice"
-                             else 2.5 * (lattice[:, 2].max() + size))
-        O.engines = hertz_engines(ip2, gravity=(0.0, 0.0, -9.81), facets=bool(holder),
-                                  rolling=table)
-        if packing == "poured":
-            rng = np.random.default_rng(np.random.SeedSequence([int(seed), POUR_STREAM]))
-            particles, settled = poured_bed.pour(len(lattice), size / 2.0, holder_radius, rng,
-                                                 "ore", say)
-            for i in holder:       # as the lattice's, half a size above the top particle,
-                O.bodies.erase(i)  # but clear of the ball that starts just above the bed
-            ball = BALL_DIAMETER / 2.0
-            clear = ball - math.sqrt(ball ** 2 - holder_radius ** 2)
-            holder = _holder(holder_radius, settled.height + min(size / 2.0, 0.9 * clear))
-        else:
-            particles = [O.bodies.append(utils.sphere(tuple(c), size / 2.0, material="ore"))
-                         for c in lattice]
-            settled = None
-            if layers > 1 and settle_steps:    # settle the stack before anything is tracked
-                O.dt = 0.2 * utils.PWaveTimeStep()
-                newton = O.engines[3]
-                newton.damping = 0.4
-                O.run(settle_steps, True)
-                newton.damping = 0.0
-                for i in particles:
-                    O.bodies[i].state.vel = (0, 0, 0)
-                    O.bodies[i].state.angVel = (0, 0, 0)
-        return {"anvil": anvil, "particles": particles, "holder": list(holder)}, settled
-
+    plan = _BedPlan(labels, overrides, lattice, holder_radius, packing, layers, size, seed,
+                    settle_steps, stiffness_scale, rolling, say)
     if packing == "poured":
         spec = {"size": size, "rings": rings, "layers": layers, "seed": int(seed),
                 "stiffness_scale": stiffness_scale, "rolling": rolling, "overrides":
                 sorted([list(k), v] for k, v in overrides.items()),
                 "holder_radius": holder_radius}
         folder = None if bed_cache is None else poured_bed.cache_folder(bed_cache)
-        bodies, settled = poured_bed.cached_scene(folder, poured_bed.cache_key(spec, mats), build)
+        bodies, settled = poured_bed.cached_scene(folder, poured_bed.cache_key(spec, mats),
+                                                  lambda: _build_bed(plan))
     else:
-        bodies, settled = build()
+        bodies, settled = _build_bed(plan)
     O.dt = YADE_DEFAULT_DT                    # attach() sets the run's time step
     named = rolling_friction(labels, overrides)[1] if rolling else {}
     particles = bodies["particles"]
     centers = (lattice if packing == "lattice"
                else np.array([tuple(O.bodies[i].state.pos) for i in particles]))
     top = max(O.bodies[i].state.pos[2] for i in particles) + size / 2.0
-    ball_radius = BALL_DIAMETER / 2.0
-    ball = utils.sphere((0.0, 0.0, top + ball_radius + 0.02 * size), ball_radius, material="steel")
-    ball.state.mass = BALL_MASS
-    inertia = 0.4 * BALL_MASS * ball_radius ** 2
-    ball.state.inertia = (inertia, inertia, inertia)
-    speed = math.sqrt(2.0 * energy / BALL_MASS)
-    ball.state.vel = (0.0, 0.0, -speed)
-    ball_id = O.bodies.append(ball)
+    ball_id, speed = _drop_ball(top, 0.02 * size, energy)
     brk = attach({"ore": material}, seed=seed, **options)
     info = {"anvil": bodies["anvil"], "particles": particles, "holder": bodies["holder"],
             "ball": ball_id, "speed": speed, "centers": centers, "material": mats["ore"],

@@ -124,7 +124,7 @@ class ImpactPool:
         (self.folder / "claimed").mkdir()
         package = str(Path(__file__).resolve().parents[2])
         worker = str(Path(__file__).resolve().parents[1] / "jobs" / "impact_worker.py")
-        from yadebreak.studies.sweep import die_with_parent  # a parent killed (even -9) takes them
+        from yadebreak.process.children import die_with_parent  # a parent killed (even -9) takes them
         self._errors = [open(self.folder / f"{j}.err", "w") for j in range(self.jobs)]
         self._procs = [subprocess.Popen(["yade", "-n", "-x", worker, str(self.folder), str(j),
                                          package],

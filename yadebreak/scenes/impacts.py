@@ -14,7 +14,8 @@ from yadebreak.model import placement
 from yadebreak.engine import add_materials, attach, run_steps
 from yadebreak.engine.parts.rolling import rolling_engine
 from yadebreak.adapter.yade_api import O, utils, wrapper as _w
-from yadebreak.jobs.lifecycle import append_whole, stop_point, stop_points
+from yadebreak.process.files import append_whole
+from yadebreak.process.signals import stop_point, stop_points
 
 
 def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False, rolling=None):

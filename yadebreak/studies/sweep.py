@@ -24,7 +24,6 @@ import math
 import os
 import re
 import shutil
-import signal
 import socket
 import subprocess
 import sys
@@ -33,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from yadebreak.jobs.lifecycle import write_atomic
+from yadebreak.process.children import die_with_parent
 
 #: the exit code of a yadebreak script refusing its options (never retried)
 USER_ERROR = 2
@@ -210,16 +210,6 @@ def run_job(argv, folder, env, cwd):
     wall = time.time() - start
     message = "" if code == 0 else _error_line(folder / "log.txt")
     return {"exit_code": code, "wall_s": wall, "worker": _worker_name(), "message": message}
-
-
-def die_with_parent():
-    """In the child, before exec: be sent SIGTERM when the worker that started us goes (Linux's
-    PR_SET_PDEATHSIG), so that a stopped sweep leaves no YADE running."""
-    try:
-        import ctypes
-        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGTERM)
-    except OSError:
-        pass
 
 
 def _worker_name():

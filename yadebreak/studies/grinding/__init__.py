@@ -15,9 +15,9 @@ per module:
 - reference: closed forms the integration is tested against (Reid's solution).
 """
 from yadebreak.studies.grinding.classes import SizeClasses, feed_masses, read_psd_csv, root2_classes
-from yadebreak.studies.grinding.spectra import (Spectra, SpectraError, from_mill_run, read_spectra,
+from yadebreak.model.spectra import (Spectra, SpectraError, from_mill_run, read_spectra,
                                               synthetic_spectra, write_spectra)
-from yadebreak.studies.grinding.capture import CaptureModel
+from yadebreak.model.capture import CaptureModel
 from yadebreak.studies.grinding.population import BatchGrinder, GrindingError, GrindResult
 from yadebreak.studies.grinding.reference import reid_batch
 

@@ -19,10 +19,8 @@ from yadebreak.options.flags import UNITS, ParamError, number, number_and_unit
 from yadebreak.studies.grinding.classes import (FeedError, class_label, feed_masses, feed_top_sieve, read_psd_csv,
                       root2_classes)
 from yadebreak.studies.grinding.population import BatchGrinder, GrindingError
-from yadebreak.studies.grinding.spectra import SpectraError, from_mill_run, read_spectra, synthetic_spectra, write_spectra
-
-#: the names a spectra file takes in a run's folder
-SPECTRA_NAME = "spectra.csv"
+from yadebreak.model.spectra import (SPECTRA_NAME, SpectraError, from_mill_run, read_spectra,
+                                     synthetic_spectra, write_spectra)
 
 
 def load_spectra(source, out):

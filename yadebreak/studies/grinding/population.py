@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from yadebreak import model
-from yadebreak.studies.grinding.capture import CaptureModel
+from yadebreak.model.capture import CaptureModel
 from yadebreak.studies.grinding.classes import SizeClasses
 from yadebreak.studies.grinding.grid import DamageTable, FractureGrid
 from yadebreak.studies.grinding.progeny import Progeny

@@ -264,14 +264,14 @@ def repeated(runner, material, size, energy, particles, impacts, seed, options):
     steel `impacts` times (scenes.impact_again); the broken leave the test. Returns the broken
     fraction after each impact, kept in runner.results."""
     from yadebreak import scenes
-    from yadebreak.adapter.yade_api import O
+    from yadebreak.scenes import view
     key = json.dumps(["repeated", material.name, material.gamma, size, energy, particles, impacts,
                       seed, sorted(options.items())])
     if key not in runner.results:
         began = time.time()
         speed = float(np.sqrt(2.0 * energy))
         brk, ids = scenes.impact_scene(material, size, [speed] * particles, seed=seed, **options)
-        home = {i: tuple(O.bodies[i].state.pos) for i in ids}
+        home = {i: view.position(i) for i in ids}
         alive, fractions = list(ids), []
         for _ in range(impacts):
             alive = scenes.impact_again(brk, alive, home, speed)

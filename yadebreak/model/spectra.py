@@ -19,8 +19,10 @@ import numpy as np
 
 from yadebreak.model import milling
 from yadebreak.model.materials import load_material
-from yadebreak.studies.grinding.capture import CaptureModel
+from yadebreak.model.capture import CaptureModel
 
+#: a spectra file's name in a run folder (a mill's spectra run, `grind`'s conversions)
+SPECTRA_NAME = "spectra.csv"
 FORMAT = "yadebreak-spectra"
 VERSION = 1
 COLUMNS = ("pair_type", "energy_low_J", "energy_high_J", "events")
@@ -77,7 +79,7 @@ class Spectra:
 def write_spectra(path, spectra):
     """Write `spectra` in the file format above (whole or not at all)."""
     import io
-    from yadebreak.jobs.lifecycle import write_atomic
+    from yadebreak.process.files import write_atomic
     path = Path(path)
     f = io.StringIO(newline="")
     f.write("# " + json.dumps(spectra.metadata()) + "\n")
