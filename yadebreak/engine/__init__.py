@@ -1,15 +1,16 @@
-"""The YADE coupling: the only part of yadebreak that imports yade.
+"""The engine in YADE's loop (docs/architecture.md).
 
     brk = yadebreak.attach(materials={"ore": "copper_ore"}, seed=1)   # after O.engines is set
-    coupling.run_steps(20000); brk.events; brk.size_distribution([1e-3])
+    engine.run_steps(20000); brk.events; brk.size_distribution([1e-3])
     yadebreak.save("scene.yade.gz")                                   # O.save with the state
 
-One step's data, in the order the engine (controller.py) moves it: contacts.py reads YADE's
-interactions into per-body loading; judging.py and criteria.py decide; state.py keeps bodies,
-events and the fines ledger; replacement.py and zeroing.py put the progeny in; stepping.py sets
-the time step and the next read; engine.py attaches it all and saves it with the scene;
-config.py holds the options. config, state, contacts, criteria and judging never import yade
-(they are tested without it); the names below that need YADE import it on first use.
+One read, in the order controller.py moves it: contacts/ reads YADE's interactions into each
+tracked body's loading; judging.py asks each body's criterion (yadebreak.criteria) which break;
+replacement.py and zeroing.py put the progeny in; stepping.py sets the time step and the next
+read; tracking.py keeps which bodies are read; state.py holds bodies, events and the fines
+ledger; scene.py attaches it all and saves it with the scene; materials.py makes YADE materials
+from material files; parts/ holds rolling friction and bond watching. The names below that need
+YADE import it on first use.
 """
 from importlib import import_module
 

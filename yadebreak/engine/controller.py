@@ -1,6 +1,6 @@
 """The per-step engine: read -> judge -> log -> replace (and zero) -> time step -> reschedule.
 
-One Controller per attached engine; `attach()` (engine.py) makes it and its PyRunners call
+One Controller per attached engine; `attach()` (scene.py) makes it and its PyRunners call
 `step()` after the InteractionLoop and the zeroing before it. Each part lives in its own module:
 contacts (reading), criteria (judging), state (bodies, events, ledger), replacement, zeroing,
 stepping (read schedule, time step, fragment damping).
