@@ -181,26 +181,26 @@ def test_a_checkpoint_keeps_the_last_read_and_the_rolling_checks(scene, tmp_path
     counts the next compares with): the state the saved run had, not a fresh one's."""
     from yadebreak import engine as coupling
     from yadebreak.engine import scene as engine
-    from yadebreak.engine.parts import rolling
+    from yadebreak.engine.parts import protocol
     from yadebreak.jobs import bed
     out = tmp_path / "cut"
     coupling.forget()
     assert bed.run(_bed_args(out, vtk_interval=0.0, checkpoint_every=0.0, stop_after=6e-4),
                    quiet=True)[1] is None                  # stopped just after its checkpoint
-    while "rolling" not in rolling._PARTS or engine.controller_of().last_iter >= scene.iter - 1:
+    while "rolling" not in protocol._LIVE or engine.controller_of().last_iter >= scene.iter - 1:
         coupling.run_steps(1)                 # to a step between reads, the rolling part rebuilt
-    ctl, part = engine.controller_of("yadebreak"), rolling._PARTS["rolling"]
+    ctl, part = engine.controller_of("yadebreak"), protocol._LIVE["rolling"]
     saved = (scene.iter, ctl.last_iter, part._checks, list(part._seen))
     coupling.save_checkpoint(out / "checkpoint.yade.gz", {})
     assert saved[1] < saved[0] - 1 and saved[2] > 1          # between reads, after many checks
     coupling.forget()
-    rolling.forget()
+    protocol.forget()
     scene.reset()
     ctl, _ = coupling.load_checkpoint(out / "checkpoint.yade.gz")
     assert (scene.iter, ctl.last_iter) == saved[:2]
     stored = json.loads(scene.tags["yadebreak_rolling:rolling"])
     assert (stored["checks"], stored["seen"]) == tuple(saved[2:])
-    assert "rolling" not in rolling._PARTS            # rebuilt from them at its next run
-    while "rolling" not in rolling._PARTS:
+    assert "rolling" not in protocol._LIVE            # rebuilt from them at its next run
+    while "rolling" not in protocol._LIVE:
         coupling.run_steps(1)
-    assert rolling._PARTS["rolling"]._checks == saved[2] + 1
+    assert protocol._LIVE["rolling"]._checks == saved[2] + 1

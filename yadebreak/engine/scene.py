@@ -6,7 +6,7 @@ import os
 from pathlib import Path
 
 from yadebreak.model.materials import MATERIALS_DIR
-from yadebreak.engine.parts import rolling
+from yadebreak.engine.parts import protocol
 from yadebreak.adapter.yade_api import O, current_scene, find_engine, scene_folder, wrapper
 from yadebreak.options.table import AttachError, Config
 from yadebreak.engine.controller import Controller
@@ -237,10 +237,10 @@ def save(path):
 
 
 def _store_all(folder=None):
-    """Every engine's and rolling friction part's state into O.tags (before O.save)."""
+    """Every engine's and part's state into O.tags (before O.save)."""
     for ctl in _ENGINES.values():
         _store(ctl, folder)
-    rolling.store()
+    protocol.store()
 
 
 def reload(label="yadebreak"):
@@ -260,7 +260,7 @@ def reload(label="yadebreak"):
     O.saveTmp(_RELOAD)
     O.loadTmp(_RELOAD)
     forget()
-    rolling.forget()
+    protocol.forget()
     for name, wall_time in walls.items():
         controller_of(name).wall_time = wall_time          # (this process's measure)
     return controller_of(label) if label is not None else None
@@ -299,7 +299,7 @@ def load_checkpoint(path, label="yadebreak"):
     if not path.exists():
         raise FileNotFoundError(f"--resume: no checkpoint at {path}; run without --resume first")
     O.load(str(path))
-    rolling.forget()                      # this process's parts: rebuilt from the loaded O.tags
+    protocol.forget()                     # this process's parts: rebuilt from the loaded O.tags
     return None if label is None else controller_of(label), json.loads(O.tags[_SCRIPT_TAG])
 
 

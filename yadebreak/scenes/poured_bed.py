@@ -23,7 +23,7 @@ import os
 from pathlib import Path
 
 from yadebreak.model import cache, placement
-from yadebreak.engine.parts import rolling
+from yadebreak.engine.parts import protocol
 from yadebreak.adapter.yade_api import O, utils, wrapper
 
 #: at rest: kinetic energy (translation and rotation) below REST_FRACTION N m g d
@@ -166,5 +166,5 @@ def cached_scene(folder, key, build):
         # it settled the bed itself
         data = json.loads(meta.read_text())
         O.load(str(scene))
-        rolling.forget()                      # rebuilt from O.tags, as in a fresh process
+        protocol.forget()                     # rebuilt from O.tags, as in a fresh process
         return data["bodies"], Settled(**{**data["settled"], "cached": cached})

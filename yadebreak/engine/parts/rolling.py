@@ -24,9 +24,8 @@ next check (at most period - 1 steps: its rolling moment then builds from there)
 """
 from __future__ import annotations
 
-import json
-
 from yadebreak.adapter.yade_api import O, utils, wrapper
+from yadebreak.engine.parts import protocol
 
 #: kr = STIFFNESS I_min / dt^2: stable (rotation frequency sqrt(2 kr / I_min) well below 2 / dt),
 #: and the cap mu_r F_n R is reached within a few steps of rolling
@@ -34,24 +33,26 @@ STIFFNESS = 0.1
 #: a pass over every interaction every FULL_PASS checks, for contacts that replaced another
 FULL_PASS = 200
 DEFAULT_PERIOD = 10
-_TAG = "yadebreak_rolling:"
-_PARTS: dict[str, "RollingFriction"] = {}
 
 
-class RollingFriction:
-    """Gives each new real interaction its pair's rolling friction (maxBendPl, kr).
+class RollingFriction(protocol.Part):
+    """Gives each new real interaction its pair's rolling friction (maxBendPl, kr), after
+    Newton's step every `period` steps.
 
     mu: {(YADE material id a, id b) with a <= b: rolling friction coefficient (-)}; pairs not in
     it (or with 0) get no rolling moment."""
 
-    def __init__(self, mu, period=DEFAULT_PERIOD):
+    kind = "rolling"
+    hook = protocol.AFTER_NEWTON
+
+    def __init__(self, mu, period=DEFAULT_PERIOD, label="rolling"):
+        super().__init__(label, period)
         self.mu = {(min(a, b), max(a, b)): float(v) for (a, b), v in mu.items()}
-        self.period = int(period)
         self._seen = []                    # each body's count of real interactions at the check
         self._checks = 0
         self.configured = 0                # contacts given their values so far
 
-    def __call__(self):
+    def act(self):
         counts = utils.numIntrsOfEachBody()
         self._checks += 1
         if self._checks % FULL_PASS == 1:             # the first check too (a loaded scene)
@@ -84,61 +85,40 @@ class RollingFriction:
             phys.kr = STIFFNESS * inertia / dt**2
             self.configured += 1
 
-    def to_dict(self):
+    def to_state(self):
         """The settings and where the checks are (which check passes over every interaction,
         the counts the next check compares with): a loaded scene configures the contacts at the
         same steps as the saved one would have."""
-        return {"mu": [[a, b, v] for (a, b), v in self.mu.items()], "period": self.period,
+        return {"mu": [[a, b, v] for (a, b), v in self.mu.items()],
                 "checks": self._checks, "seen": list(self._seen)}
 
     @classmethod
-    def from_dict(cls, data):
-        part = cls({(a, b): v for a, b, v in data["mu"]}, data["period"])
-        part._checks = data.get("checks", 0)
-        part._seen = list(data.get("seen", ()))
+    def from_state(cls, label, period, state):
+        part = cls({(a, b): v for a, b, v in state["mu"]}, period, label)
+        part._checks = state.get("checks", 0)
+        part._seen = list(state.get("seen", ()))
         return part
 
 
 def rolling_engine(mu, period=DEFAULT_PERIOD, label="rolling"):
     """The PyRunner that applies rolling friction `mu` ({(material id, id): mu_r}) every `period`
-    steps; its settings travel in O.tags, so that a saved scene finds them again."""
-    part = RollingFriction(mu, period)
-    _PARTS[label] = part
-    O.tags[_TAG + label] = json.dumps(part.to_dict())
-    return wrapper.PyRunner(
-        command=f"__import__('yadebreak.engine.parts.rolling').engine.parts.rolling.on_step({label!r})",
-        iterPeriod=part.period, initRun=True, label=label, updateGlobals=False)
+    steps (after Newton's step); its settings travel in O.tags, so that a saved scene finds them
+    again."""
+    return protocol.install(RollingFriction(mu, period, label))
 
 
 def on_step(label):
-    """Called by the PyRunner; after O.load, the part is rebuilt from O.tags."""
-    part = _PARTS.get(label)
-    if part is None:
-        part = _PARTS[label] = RollingFriction.from_dict(json.loads(O.tags[_TAG + label]))
-    part()
+    """The entry point that scenes saved by earlier versions name in their PyRunner commands."""
+    protocol.run(RollingFriction.kind, label)
 
 
 def share_pairs(parent, alias):
     """Material `alias` (a copy of `parent`, e.g. the dummies' softer one) gets `parent`'s
-    rolling friction in every part of this process and in the settings stored with the scene."""
-    for label, part in _PARTS.items():
-        if _TAG + label not in O.tags.keys():
-            continue                      # a part of an earlier scene of this process
+    rolling friction in every part of this scene, and in the settings stored with it."""
+    for part in protocol.live(RollingFriction.kind).values():
         for (a, b), mu in list(part.mu.items()):
             if parent in (a, b):
                 other = b if a == parent else a
                 for pair in ((alias, other),) + (((alias, alias),) if other == parent else ()):
                     part.mu[(min(pair), max(pair))] = mu
-        O.tags[_TAG + label] = json.dumps(part.to_dict())
-
-
-def store():
-    """Each part of this scene into O.tags with where its checks are (before O.save)."""
-    for label, part in _PARTS.items():
-        if _TAG + label in O.tags.keys():
-            O.tags[_TAG + label] = json.dumps(part.to_dict())
-
-
-def forget():
-    """Drop this process's parts: the next step rebuilds them from O.tags (after O.load)."""
-    _PARTS.clear()
+        protocol.save_state(part)

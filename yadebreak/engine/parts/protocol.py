@@ -1,0 +1,131 @@
+"""The protocol of a part that runs in YADE's loop (in the spirit of HOOMD-blue's custom actions
+and LAMMPS fixes): a part says when it acts (its hook in YADE's loop and its period in steps),
+acts, and gives and takes its state, so that one store saves every part with the scene and
+restores it after O.load, in this process or another.
+
+    class Mine(Part):
+        kind = "mine"                          # its name in the registry and in O.tags
+        hook = AFTER_INTERACTIONS
+        def act(self): ...
+        def to_state(self): return {...}       # JSON-able
+        @classmethod
+        def from_state(cls, label, period, state): return cls(...)
+
+    O.engines = O.engines + [install(Mine(...))]   # the PyRunner that calls it
+
+Adding a part is one file with its class. A PyRunner calls `run(label)`, which finds the part
+in this process or restores it from the scene's O.tags (`yadebreak_<kind>:<label>`); `store()`
+writes every part of the scene into O.tags before O.save, `forget()` drops this process's parts
+(after O.load, the next run restores them). One PyRunner per part keeps YADE's iterPeriod doing
+the waiting: Python in YADE's loop costs a few microseconds per call, so a part due every k
+steps costs nothing on the other k - 1.
+"""
+from __future__ import annotations
+
+import json
+
+from yadebreak.adapter.yade_api import O, current_scene, wrapper
+
+#: where in YADE's loop a part's PyRunner stands
+BEFORE_INTERACTIONS = "before_interactions"
+AFTER_INTERACTIONS = "after_interactions"
+AFTER_NEWTON = "after_newton"
+HOOKS = (BEFORE_INTERACTIONS, AFTER_INTERACTIONS, AFTER_NEWTON)
+
+_KINDS: dict[str, type] = {}              # kind -> Part subclass
+_LIVE: dict[str, "Part"] = {}             # label -> this process's part
+_SCENE_OF: dict[str, object] = {}         # label -> the scene its part belongs to
+
+
+class Part:
+    """One piece of work in YADE's loop; `label` names its PyRunner, `period` its steps."""
+
+    kind: str = ""
+    hook: str = AFTER_INTERACTIONS
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if cls.kind:
+            if cls.kind in _KINDS and _KINDS[cls.kind] is not cls:
+                raise ValueError(f"a part of kind {cls.kind!r} is registered already")
+            if cls.hook not in HOOKS:
+                raise ValueError(f"part {cls.kind!r}: hook {cls.hook!r}, accepted {HOOKS}")
+            _KINDS[cls.kind] = cls
+
+    def __init__(self, label, period=1):
+        self.label = label
+        self.period = int(period)
+
+    def act(self):
+        raise NotImplementedError
+
+    def to_state(self):
+        """The part's state as a JSON-able dict (period and label are kept beside it)."""
+        return {}
+
+    @classmethod
+    def from_state(cls, label, period, state):
+        return cls(label, period)
+
+    @property
+    def tag(self):
+        return tag_of(self.kind, self.label)
+
+
+def tag_of(kind, label):
+    """The O.tags key of a part."""
+    return f"yadebreak_{kind}:{label}"
+
+
+def install(part):
+    """Register `part` in this process and the scene (its state in O.tags) and return its
+    PyRunner, to be put in O.engines where its hook says."""
+    _hold(part)
+    save_state(part)
+    # updateGlobals=False: YADE would otherwise copy the caller's locals into __main__ after each
+    # call (a user's `steps` or `_` changed by O.step() in a function)
+    return wrapper.PyRunner(
+        command=f"__import__('yadebreak.engine.parts.protocol').engine.parts.protocol."
+                f"run({part.kind!r}, {part.label!r})",
+        iterPeriod=part.period, initRun=True, label=part.label, updateGlobals=False)
+
+
+def _hold(part):
+    _LIVE[part.label] = part
+    _SCENE_OF[part.label] = current_scene()
+
+
+def save_state(part):
+    O.tags[part.tag] = json.dumps({**part.to_state(), "period": part.period})
+
+
+def live(kind):
+    """This process's parts of `kind` of the current scene: {label: part}."""
+    scene = current_scene()
+    return {label: p for label, p in _LIVE.items()
+            if p.kind == kind and _SCENE_OF[label] == scene}
+
+
+def run(kind, label):
+    """Called by a part's PyRunner: the part acts, restored from O.tags first when this process
+    holds none of this scene (after O.load, or a part of an earlier scene)."""
+    part = _LIVE.get(label)
+    if part is None or _SCENE_OF[label] != current_scene():
+        data = json.loads(O.tags[tag_of(kind, label)])
+        part = _KINDS[kind].from_state(label, data.get("period", 1), data)
+        _hold(part)
+    part.act()
+
+
+def store():
+    """Every part of this scene into O.tags with its state now (before O.save)."""
+    scene = current_scene()
+    for label, part in _LIVE.items():
+        if _SCENE_OF[label] == scene:
+            save_state(part)
+
+
+def forget():
+    """Drop this process's parts: the next run of each rebuilds it from O.tags (after O.load)."""
+    _LIVE.clear()
+    _SCENE_OF.clear()
