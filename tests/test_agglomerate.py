@@ -18,6 +18,7 @@ def _two_spheres(radius, distance, binder_changes, seed=1):
     from yade import O, utils
     from yadebreak.model import bonds
     from yadebreak.engine.parts import bonds as bonded
+    from yadebreak.scenes import agglomerate as scene_of_bonds
     mat = bonds.load_agglomerate_material("glass_epoxy")
     mat = mat.with_binder(**binder_changes)
     sphere_mat = O.materials.append(__import__("yade").wrapper.FrictMat(
@@ -26,7 +27,7 @@ def _two_spheres(radius, distance, binder_changes, seed=1):
     ids = np.array([O.bodies.append(utils.sphere((0, 0, 0), radius, material=sphere_mat,
                                                  fixed=True)),
                     O.bodies.append(utils.sphere((distance, 0, 0), radius, material=sphere_mat))])
-    O.engines = bonded.bonded_engines(mat.spheres, gravity=0.0)
+    O.engines = scene_of_bonds.bonded_engines(mat.spheres, gravity=0.0)
     watch, scale = bonded.attach_bonds(ids, np.array([[0, 1]]), np.array([distance]),
                                        np.array([radius, radius]), mat.binder,
                                        np.random.default_rng(seed))
@@ -70,6 +71,7 @@ def test_bonded_cantilever_deflects_as_timoshenko(scene):
     from yade import O
     from yadebreak.model import bonds
     from yadebreak.engine.parts import bonds as bonded
+    from yadebreak.scenes import agglomerate as scene_of_bonds
     length, radius = 2e-3, 0.8e-3
     mat, ids, watch = _two_spheres(radius, length, {"radius_multiplier": 0.5,
                                                     "tensile_strength": 1e5,
@@ -153,6 +155,7 @@ def test_small_agglomerate_breaks_as_the_document_reports(scene, tmp_path):
 
 def agglomerate_watch():
     from yadebreak.engine.parts import bonds as bonded
+    from yadebreak.scenes import agglomerate as scene_of_bonds
     return bonded._WATCHES[bonded.LABEL]
 
 
@@ -176,6 +179,7 @@ def test_the_scalar_screen_never_misses_a_bond_near_its_strength(scene, tmp_path
     from yadebreak.jobs import agglomerate
     from yadebreak.model import bonds
     from yadebreak.engine.parts import bonds as bonded
+    from yadebreak.scenes import agglomerate as scene_of_bonds
     from yade import O
     agglomerate.run(_args(tmp_path, particles=200, duration=2e-5), quiet=True)
     watch = agglomerate_watch()
@@ -212,10 +216,11 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
     """Checkpoints, a kill after bonds broke past the last checkpoint (their lines written), and
     --resume: bonds_broken.csv (each bond once), timeseries.csv and the summary (but for wall
     times) are the uninterrupted run's to the last digit: checkpoints are written where every run
-    renews its contacts as a load would (bonded.renew_contacts)."""
+    renews its contacts as a load would (scene_of_bonds.renew_contacts)."""
     from yade import O
     from yadebreak.jobs import agglomerate
     from yadebreak.engine.parts import bonds as bonded
+    from yadebreak.scenes import agglomerate as scene_of_bonds
     from yadebreak.jobs.lifecycle import RunFinished, ScriptError
     small = dict(particles=120, duration=1.5e-4)     # 89 of 431 bonds break, by 0.1 ms
     whole = agglomerate.run(_args(tmp_path / "whole", checkpoint_every=-1.0, **small), quiet=True)
@@ -224,7 +229,7 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
     assert agglomerate.run(died, quiet=True) is None
     assert not (cut / "summary.json").exists()
     O.reset()
-    saved, _ = bonded.load_checkpoint(cut / "checkpoint.yade.gz")
+    saved, _ = scene_of_bonds.load_checkpoint(cut / "checkpoint.yade.gz")
     at_checkpoint = saved.watch.broken_count()
     assert 0 < at_checkpoint < len(_rows(cut / "bonds_broken.csv"))
     # goes on without checkpoints and dies again: more lines past the checkpoint
@@ -283,21 +288,22 @@ def test_a_time_step_that_cannot_finish_is_refused_before_the_run(scene, tmp_pat
 
 
 def test_a_bonded_scene_loads_with_its_watch_and_a_plain_save_is_refused(scene, tmp_path):
-    """O.save does not store the BondWatch: bonded.save_checkpoint keeps it in O.tags, and after
+    """O.save does not store the BondWatch: scene_of_bonds.save_checkpoint keeps it in O.tags, and after
     a plain O.load of that file the first step restores it (the same bonds, modes, strengths and
     counts, and the run goes on breaking bonds); a scene O.saved later, whose stored state is
     stale, is refused at its first step rather than run with the wrong bonds."""
     from yade import O
     from yadebreak.jobs import agglomerate
     from yadebreak.engine.parts import bonds as bonded
+    from yadebreak.scenes import agglomerate as scene_of_bonds
     material, packing = agglomerate.build(_args(tmp_path, particles=60))
     O.reset()
-    built = bonded.agglomerate_scene(material, packing, seed=3)
+    built = scene_of_bonds.agglomerate_scene(material, packing, seed=3)
     while built.watch.broken_count() < 3:
         O.step()
     before = built.watch
     saved_mode, saved_checks = before.mode.copy(), before.checks
-    bonded.save_checkpoint(tmp_path / "c.yade.gz", built, {"any": 1})
+    scene_of_bonds.save_checkpoint(tmp_path / "c.yade.gz", built, {"any": 1})
     O.run(20, True)
     O.save(str(tmp_path / "plain.yade.gz"))               # the tags still hold the earlier state
     bonded._WATCHES.clear()

@@ -1,7 +1,7 @@
 """The bonded agglomerate's impact on a rigid plane behind scripts/agglomerate_impact.py
-(coupling layer: runs YADE, writes outputs). docs/bonded.md: the model and the case.
+(a job: its scene from scenes/agglomerate.py, its outputs). docs/bonded.md: the model and the case.
 
-The agglomerate is built (bonds.pack_in_sphere), bonded (coupling.bonded), dropped at --speed
+The agglomerate is built (bonds.pack_in_sphere), bonded (scenes.agglomerate), dropped at --speed
 onto a steel plane and followed for --duration seconds from its first touch (t = 0, as the
 document's video frames). Every --sample-interval it records the damage ratio, the bonds broken
 by mode, the bonds at >= 80 % of a strength, the kinetic energy and the debris that has left the
@@ -25,8 +25,9 @@ from scipy.spatial import cKDTree
 
 from yadebreak.model import bonds
 from yadebreak.jobs import paraview
-from yadebreak.engine.parts import bonds as bonded
-from yadebreak.engine.parts.bonds import WATCH_LEVEL, agglomerate_scene
+from yadebreak.engine.parts.bonds import WATCH_LEVEL
+from yadebreak.scenes import agglomerate as bonded
+from yadebreak.scenes.agglomerate import agglomerate_scene
 from yadebreak.engine.scene import run_steps
 from yadebreak.scenes import view
 from yadebreak.jobs import skeleton

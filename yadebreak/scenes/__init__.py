@@ -6,6 +6,7 @@ impact_pool YADE worker processes running impact scenes from a queue (no yade im
 beds        a ball on a bed of particles (lattice or poured)
 poured_bed  beds poured and settled under gravity, and their cache
 mill        the laboratory ball mill: drum, lifters, charge; its torque and charge state
+agglomerate a bonded agglomerate dropped on a plane, its checkpoints
 extremes    the stability matrix's pairs fired at each other and facet corners
 view        what a job reads of the running scene and asks of the YADE process
 """
