@@ -155,8 +155,7 @@ def test_small_agglomerate_breaks_as_the_document_reports(scene, tmp_path):
 
 def agglomerate_watch():
     from yadebreak.engine.parts import bonds as bonded
-    from yadebreak.scenes import agglomerate as scene_of_bonds
-    return bonded._WATCHES[bonded.LABEL]
+    return bonded.watch_of()
 
 
 def test_build_and_breakage_are_reproducible_from_the_seed(scene, tmp_path):
@@ -220,6 +219,7 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
     from yade import O
     from yadebreak.jobs import agglomerate
     from yadebreak.engine.parts import bonds as bonded
+    from yadebreak.engine.parts import protocol
     from yadebreak.scenes import agglomerate as scene_of_bonds
     from yadebreak.jobs.lifecycle import RunFinished, ScriptError
     small = dict(particles=120, duration=1.5e-4)     # 89 of 431 bonds break, by 0.1 ms
@@ -234,14 +234,14 @@ def test_a_killed_run_resumes_to_the_same_bonds_broken_without_duplicate_lines(s
     assert 0 < at_checkpoint < len(_rows(cut / "bonds_broken.csv"))
     # goes on without checkpoints and dies again: more lines past the checkpoint
     O.reset()
-    bonded._WATCHES.clear()                  # as in a new process
+    protocol.forget()                  # as in a new process
     again = _args(cut, checkpoint_every=-1.0, stop_after=7e-5, resume=True, **small)
     assert agglomerate.run(again, quiet=True) is None
     assert len(_rows(cut / "bonds_broken.csv")) > at_checkpoint
     with pytest.raises(ScriptError, match=r"other values of \['speed'\]"):
         agglomerate.run(_args(cut, speed=5.0, resume=True, **small), quiet=True)
     O.reset()
-    bonded._WATCHES.clear()
+    protocol.forget()
     resumed = agglomerate.run(_args(cut, checkpoint_every=-1.0, resume=True, **small),
                               quiet=True)
     assert whole["bonds_broken_tension"] > at_checkpoint
@@ -288,13 +288,14 @@ def test_a_time_step_that_cannot_finish_is_refused_before_the_run(scene, tmp_pat
 
 
 def test_a_bonded_scene_loads_with_its_watch_and_a_plain_save_is_refused(scene, tmp_path):
-    """O.save does not store the BondWatch: scene_of_bonds.save_checkpoint keeps it in O.tags, and after
+    """O.save does not store the BondWatch: save_checkpoint keeps it in O.tags, and after
     a plain O.load of that file the first step restores it (the same bonds, modes, strengths and
     counts, and the run goes on breaking bonds); a scene O.saved later, whose stored state is
     stale, is refused at its first step rather than run with the wrong bonds."""
     from yade import O
     from yadebreak.jobs import agglomerate
     from yadebreak.engine.parts import bonds as bonded
+    from yadebreak.engine.parts import protocol
     from yadebreak.scenes import agglomerate as scene_of_bonds
     material, packing = agglomerate.build(_args(tmp_path, particles=60))
     O.reset()
@@ -306,10 +307,10 @@ def test_a_bonded_scene_loads_with_its_watch_and_a_plain_save_is_refused(scene, 
     scene_of_bonds.save_checkpoint(tmp_path / "c.yade.gz", built, {"any": 1})
     O.run(20, True)
     O.save(str(tmp_path / "plain.yade.gz"))               # the tags still hold the earlier state
-    bonded._WATCHES.clear()
+    protocol.forget()
     O.load(str(tmp_path / "c.yade.gz"))
     O.step()
-    watch = bonded._WATCHES[bonded.LABEL]
+    watch = bonded.watch_of()
     assert watch is not before
     assert watch.checks == saved_checks + 1                   # the step after the load: checked
     assert np.all(watch.mode[saved_mode != 0] == saved_mode[saved_mode != 0])

@@ -20,7 +20,7 @@ from yadebreak.model import bonds, placement
 from yadebreak.options.table import AttachError
 from yadebreak.engine import scene as engine_scene
 from yadebreak.engine.parts.bonds import (LABEL, MAX_STEPS, TAG, TIME_STEP, BondWatch,  # noqa: F401
-                                          attach_bonds, restore_watch)
+                                          attach_bonds, watch_of)
 from yadebreak.adapter.yade_api import O, utils, wrapper as _w
 
 
@@ -115,10 +115,11 @@ def set_rolling_stiffness(smallest_inertia):
 
 
 def save_checkpoint(path, scene, script_state):
-    """engine.save_checkpoint (the scene to `path` atomically, with a script's loop state) with
-    the BondWatch of `scene` (an AgglomerateScene) kept in O.tags."""
+    """engine.save_checkpoint (the scene to `path` atomically, with a script's loop state and
+    every part's state, the BondWatch's included) with the record of `scene` (an
+    AgglomerateScene: its ids and time scales) in O.tags."""
     O.tags[TAG] = json.dumps({
-        "iter": O.iter, "label": LABEL, "watch": scene.watch.to_dict(),
+        "iter": O.iter, "label": LABEL,
         "sphere_ids": scene.sphere_ids.tolist(), "target_id": int(scene.target_id),
         "time_scale": scene.time_scale, "rayleigh_time": scene.rayleigh_time})
     engine_scene.save_checkpoint(path, script_state)
@@ -153,8 +154,13 @@ def load_checkpoint(path):
 
 def restore_scene():
     """The AgglomerateScene of a scene loaded from save_checkpoint's file, its BondWatch
-    registered again (engine.parts.bonds.restore_watch)."""
-    watch, data = restore_watch()
+    restored (engine.parts.bonds.watch_of). RuntimeError if the scene has no such record."""
+    if TAG not in O.tags.keys() or not O.tags[TAG]:
+        raise RuntimeError("this bonded scene has no BondWatch state: its bonds are watched by "
+                           "the process that built it, or saved with "
+                           "scenes.agglomerate.save_checkpoint")
+    data = json.loads(O.tags[TAG])
+    watch = watch_of(data["label"])
     ids = np.array(data["sphere_ids"], np.int64)
     masses = np.array([O.bodies[int(i)].state.mass for i in ids])
     return AgglomerateScene(ids, data["target_id"], watch, masses, data["time_scale"],

@@ -26,13 +26,13 @@ import numpy as np
 from yadebreak.model import bonds
 from yadebreak.model.intervals import Interval
 from yadebreak.adapter.yade_api import O, utils, wrapper as _w
+from yadebreak.engine.parts import protocol
 
 #: stresses at or above this fraction of a bond's strength are counted (the document's Fig. 18)
 WATCH_LEVEL = 0.8
 #: the PyRunner's label, and the key of its BondWatch
 LABEL = "bond_watch"
-_WATCHES: dict = {}
-#: O.tags key of the BondWatch's state and the scene's ids (written by save_checkpoint)
+#: O.tags key of the agglomerate's record (its ids; with the watch's state in earlier versions)
 TAG = "yadebreak_bonds"
 #: an adhesion YADE's cohesive law never reaches (N, N m): bonds break here, not there
 NEVER = 1e30
@@ -52,43 +52,52 @@ def attach_bonds(ids, pairs, lengths, radii, binder, rng, target_id=None, check_
     time_scale = bonds.bond_time_scale(masses, 0.4 * masses * radii**2, pairs,
                                        network.stiffness, network.lever_a, network.lever_b)
     watch = BondWatch(network, target_id, check_period=check_period)
-    watch.last_iter = max(O.iter, 1) - 1    # YADE first runs a PyRunner at iteration 1 or later
-    _WATCHES[LABEL] = watch
-    # updateGlobals=False: YADE would otherwise copy the caller's locals into __main__ each call
-    O.engines = O.engines + [_w.PyRunner(
-        command=f"__import__('yadebreak.engine.parts.bonds').engine.parts.bonds.on_step({LABEL!r})",
-        iterPeriod=1, label=LABEL, updateGlobals=False)]
+    O.engines = O.engines + [protocol.install(BondPart(LABEL, watch))]
     return watch, time_scale
 
 
+class BondPart(protocol.Part):
+    """The BondWatch in YADE's loop: after Newton's step, every step; its state (the bonds as
+    built, which broke when and how) goes with the scene (protocol)."""
+
+    kind = "bonds"
+    hook = protocol.AFTER_NEWTON
+
+    def __init__(self, label, watch):
+        super().__init__(label, 1)
+        self.watch = watch
+
+    def act(self):
+        self.watch()
+
+    def to_state(self):
+        return {"iter": O.iter, "label": self.label, "watch": self.watch.to_dict()}
+
+    @classmethod
+    def from_state(cls, label, period, state):
+        """The watch restored (reading the intact bonds' interactions); RuntimeError if the
+        scene ran on after it was stored (an O.save does not store it)."""
+        if state["iter"] != O.iter:
+            raise RuntimeError(f"the BondWatch's state in this scene was stored at step "
+                               f"{state['iter']} and the scene is at step {O.iter}: O.save does "
+                               "not store it; save bonded scenes with yadebreak.save or "
+                               "scenes.agglomerate.save_checkpoint")
+        return cls(label, BondWatch.from_dict(state["watch"]))
+
+    @classmethod
+    def legacy_state(cls, label):
+        """Checkpoints of earlier versions keep the watch in the scene's record (TAG)."""
+        return json.loads(O.tags[TAG]) if TAG in O.tags.keys() and O.tags[TAG] else None
+
+
+def watch_of(label=LABEL):
+    """The BondWatch of the current scene (restored from it after O.load)."""
+    return protocol.part_of(BondPart.kind, label).watch
+
+
 def on_step(label):
-    """Called by the PyRunner after Newton's step. A watch that did not see the previous step
-    (the scene was loaded, or went back in time) is restored from the scene."""
-    watch = _WATCHES.get(label)
-    if watch is None or O.iter != watch.last_iter + 1:
-        watch = restore_watch()[0]
-    watch.last_iter = O.iter
-    watch()
-
-
-def restore_watch():
-    """The BondWatch stored in the scene's O.tags (by scenes.agglomerate.save_checkpoint),
-    registered again (reading the intact bonds' interactions); returns (watch, the stored
-    record). Raises RuntimeError if the scene has no BondWatch state or ran on after it was
-    stored (an O.save does not store it)."""
-    if TAG not in O.tags.keys() or not O.tags[TAG]:
-        raise RuntimeError("this bonded scene has no BondWatch state: its bonds are watched by "
-                           "the process that built it, or saved with "
-                           "scenes.agglomerate.save_checkpoint")
-    data = json.loads(O.tags[TAG])
-    if data["iter"] != O.iter:
-        raise RuntimeError(f"the BondWatch's state in this scene was stored at step "
-                           f"{data['iter']} and the scene is at step {O.iter}: O.save does not "
-                           "store it; save bonded scenes with scenes.agglomerate.save_checkpoint")
-    watch = BondWatch.from_dict(data["watch"])
-    watch.last_iter = O.iter - 1
-    _WATCHES[data["label"]] = watch
-    return watch, data
+    """The entry point that scenes saved by earlier versions name in their PyRunner commands."""
+    protocol.run(BondPart.kind, label)
 
 
 @dataclass
@@ -198,7 +207,6 @@ class BondWatch:
         self.bonds_read = 0
         self.seconds = 0.0                           # wall time spent in check() (cost report)
         self.on_failure = None                       # callable(rows, modes, time), if set
-        self.last_iter = -1                          # O.iter of the last call (on_step)
 
     _STATE = ("touch_time", "checks", "bonds_read", "seconds", "check_period", "target_id")
 

@@ -67,6 +67,11 @@ class Part:
     def from_state(cls, label, period, state):
         return cls(label, period)
 
+    @classmethod
+    def legacy_state(cls, label):
+        """The state of a scene saved before this part had its own O.tags key (None: none)."""
+        return None
+
     @property
     def tag(self):
         return tag_of(self.kind, self.label)
@@ -107,14 +112,24 @@ def live(kind):
 
 
 def run(kind, label):
-    """Called by a part's PyRunner: the part acts, restored from O.tags first when this process
+    """Called by a part's PyRunner: the part acts (see part_of)."""
+    part_of(kind, label).act()
+
+
+def part_of(kind, label):
+    """The part `label` of the current scene, restored from O.tags first when this process
     holds none of this scene (after O.load, or a part of an earlier scene)."""
     part = _LIVE.get(label)
     if part is None or _SCENE_OF[label] != current_scene():
-        data = json.loads(O.tags[tag_of(kind, label)])
-        part = _KINDS[kind].from_state(label, data.get("period", 1), data)
+        cls, tag = _KINDS[kind], tag_of(kind, label)
+        data = (json.loads(O.tags[tag]) if tag in O.tags.keys() and O.tags[tag]
+                else cls.legacy_state(label))
+        if data is None:
+            raise RuntimeError(f"the scene has no state of yadebreak's {kind} part {label!r}: "
+                               "save scenes with yadebreak.save or a job's checkpoint")
+        part = cls.from_state(label, data.get("period", 1), data)
         _hold(part)
-    part.act()
+    return part
 
 
 def store():
