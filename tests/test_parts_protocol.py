@@ -23,7 +23,7 @@ def _toy_kind():
             self.calls += 1
             self.steps.append(O.iter)
 
-        def to_state(self):
+        def to_state(self, folder=None):
             return {"calls": self.calls}
 
         @classmethod

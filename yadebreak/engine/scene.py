@@ -1,4 +1,8 @@
-"""Attaching the engine to a scene, finding it again after O.load, and saving it with the scene."""
+"""Attaching the engine to a scene, finding it again after O.load, and saving it with the scene.
+
+The engine is two parts of YADE's loop (engine/parts/protocol.py): BreakageEngine, after the
+InteractionLoop when the read schedule says, holds the controller and its state; Zeroing, before
+the InteractionLoop, zeroes the fragments' artificial overlaps (asleep while there are none)."""
 from __future__ import annotations
 
 import json
@@ -7,15 +11,13 @@ from pathlib import Path
 
 from yadebreak.model.materials import MATERIALS_DIR
 from yadebreak.engine.parts import protocol
-from yadebreak.adapter.yade_api import O, current_scene, find_engine, scene_folder, wrapper
+from yadebreak.adapter.yade_api import O, find_engine, scene_folder, wrapper
 from yadebreak.options.table import AttachError, Config
 from yadebreak.engine.controller import Controller
 from yadebreak.engine.materials import breakable_spheres, check_mapping, dummy_materials, resolve
 from yadebreak.engine.state import EngineState, EventLog
 from yadebreak.engine.stepping import smallest_rayleigh_time
 
-_ENGINES: dict[str, Controller] = {}
-_SCENE_OF: dict[str, object] = {}          # label -> the scene its controller belongs to
 _TAG = "yadebreak:"
 _SCRIPT_TAG = "yadebreak_script"
 _RELOAD = "yadebreak_reload"              # reload()'s in-memory save
@@ -23,13 +25,57 @@ _RELOAD = "yadebreak_reload"              # reload()'s in-memory save
 YADE_DEFAULT_DT = 1e-8
 
 
-def _runner(command, label, runner_label, period, dead=False):
-    # updateGlobals=False: YADE would otherwise copy the caller's locals into __main__ after
-    # each call (a user's `steps` or `_` changed by O.step() in a function)
-    return wrapper.PyRunner(command=f"__import__('yadebreak.engine.scene').engine.scene."
-                                    f"{command}({label!r})",
-                            iterPeriod=period, initRun=True, label=runner_label, dead=dead,
-                            updateGlobals=False)
+class BreakageEngine(protocol.Part):
+    """The engine's read, after the InteractionLoop every `period` steps (the read schedule sets
+    the PyRunner's iterPeriod); its state is the controller's (_state)."""
+
+    kind = "breakage"
+    hook = protocol.AFTER_INTERACTIONS
+
+    def __init__(self, label, controller):
+        super().__init__(label, controller.period)
+        self.controller = controller
+
+    @classmethod
+    def tag_for(cls, label):
+        return _TAG + label                  # the key every saved scene holds
+
+    def act(self):
+        self.controller.step()
+
+    def current(self):
+        """It read at the last read this scene made (else the scene was loaded or went back)."""
+        ctl = self.controller
+        return ctl.last_iter < O.iter <= ctl.last_iter + ctl.period
+
+    def to_state(self, folder=None):
+        return _state(self.controller, folder)
+
+    @classmethod
+    def from_state(cls, label, period, state):
+        return cls(label, _restore(label, state))
+
+    @classmethod
+    def legacy_state(cls, label):
+        raise AttachError(f"yadebreak engine '{label}' has no state in this scene")
+
+    def close(self):
+        self.controller.close()
+
+
+class Zeroing(protocol.Part):
+    """The engine's zeroing of artificial overlaps, before the InteractionLoop; asleep while
+    there are none (engine/zeroing.py wakes it). Its state is the controller's."""
+
+    kind = "breakage_zero"
+    hook = protocol.BEFORE_INTERACTIONS
+
+    def act(self):
+        controller_of(self.label.removesuffix("_zero")).zero_overlaps()
+
+    @classmethod
+    def legacy_state(cls, label):
+        return {}                            # nothing of its own to restore
 
 
 def attach(materials, seed=0, *, label="yadebreak", **options):
@@ -44,7 +90,7 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     config = Config.from_options(seed=seed, **options)
     found = check_mapping(materials)
     _check_event_log(config.output.event_log)
-    if label in _ENGINES and find_engine(label) is not None:
+    if label in protocol.live(BreakageEngine.kind) and find_engine(label) is not None:
         raise AttachError(f"yadebreak is already attached to this scene as '{label}': call attach "
                           "once per scene (or give another label)")
     engines = list(O.engines)
@@ -72,12 +118,12 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     ctl.damping.apply_at_attach()
     user_dt = None if O.dt == YADE_DEFAULT_DT else O.dt
     ctl.time_step.at_attach(smallest_rayleigh_time(), user_dt)
-    engines.insert(loop_idx + 1, _runner("on_read", label, label, ctl.period))
-    engines.insert(loop_idx, _runner("on_zero", label, label + "_zero", 1, dead=True))
-    O.engines = engines
     ctl.last_iter = O.iter - 1
-    _hold(label, ctl)
-    _store(ctl)
+    part = BreakageEngine(label, ctl)
+    engines.insert(loop_idx + 1, protocol.install(part))
+    engines.insert(loop_idx, protocol.install(Zeroing(label + "_zero"), dead=True))
+    O.engines = engines
+    protocol.save_state(part)                # with its runners' counts
     return ctl
 
 
@@ -101,54 +147,38 @@ def _check_event_log(path):
 def _check_not_tracked_elsewhere(label, ids):
     """One engine per body: a second label over bodies another one tracks would judge and break
     them twice."""
-    for other, ctl in _ENGINES.items():
-        if other == label or find_engine(other) is None or _SCENE_OF.get(other) != current_scene():
+    for other, part in protocol.live(BreakageEngine.kind).items():
+        if other == label or find_engine(other) is None:
             continue
-        shared = sorted(set(ids) & set(ctl.bodies))
+        shared = sorted(set(ids) & set(part.controller.bodies))
         if shared:
             raise AttachError(f"bodies {shared[:5]}{' ...' if len(shared) > 5 else ''} are "
                               f"tracked by the yadebreak engine '{other}' already: map each "
                               "breakable material in one attach() only")
 
 
-def _hold(label, ctl):
-    _ENGINES[label] = ctl
-    _SCENE_OF[label] = current_scene()
-
-
 def detach(label="yadebreak"):
     """Remove the engine `label` from the scene (its PyRunners, its saved state); returns its
     controller, whose events and results stay readable."""
-    ctl = _ENGINES.pop(label, None)
-    _SCENE_OF.pop(label, None)
+    part = protocol.drop(label)               # its controller closed
+    protocol.drop(label + "_zero")
     O.engines = [e for e in O.engines if getattr(e, "label", "") not in (label, label + "_zero")]
-    if _TAG + label in O.tags.keys():
-        O.tags[_TAG + label] = ""              # O.tags cannot delete a key
-    if ctl is not None:
-        ctl.close()
-    return ctl
+    for tag in (BreakageEngine.tag_for(label), Zeroing.tag_for(label + "_zero")):
+        if tag in O.tags.keys():
+            O.tags[tag] = ""                   # O.tags cannot delete a key
+    return part.controller if part is not None else None
 
 
 def forget():
     """Forget every engine attached in this process (after O.reset(), or in tests): the next
     call finds them again from the scene's O.tags."""
-    for ctl in _ENGINES.values():
-        ctl.close()
-    _ENGINES.clear()
-    _SCENE_OF.clear()
+    protocol.forget((BreakageEngine.kind, Zeroing.kind))
 
 
 def controller_of(label="yadebreak"):
     """The controller of engine `label`, restored from the scene when it was loaded (O.load
     after yadebreak.save, in this process or another) or went back in time."""
-    ctl = _ENGINES.get(label)
-    if (ctl is None or O.iter <= ctl.last_iter or O.iter > ctl.last_iter + ctl.period
-            or _SCENE_OF[label] != current_scene()):
-        if ctl is not None:
-            ctl.close()
-        ctl = _restore(label)
-        _hold(label, ctl)
-    return ctl
+    return protocol.part_of(BreakageEngine.kind, label).controller
 
 
 def _runs(label):
@@ -158,13 +188,13 @@ def _runs(label):
     return [getattr(find_engine(name), "nDone", 0) for name in (label, label + "_zero")]
 
 
-def _store(ctl, folder=None):
-    """Everything needed to go on after O.load, as JSON in O.tags. The event log is named
-    relative to `folder`, the saved scene file's (else relative to the working folder): a run
-    folder moved or copied with its log goes on writing its own."""
+def _state(ctl, folder=None):
+    """Everything needed to go on after O.load (JSON-able). The event log is named relative to
+    `folder`, the saved scene file's (else relative to the working folder): a run folder moved
+    or copied with its log goes on writing its own."""
     options = ctl.config.as_options()
     log = options.pop("event_log")
-    O.tags[_TAG + ctl.label] = json.dumps({
+    return {
         "label": ctl.label, "options": options,
         "event_log": None if log is None else {
             "path": os.path.relpath(os.path.abspath(log), folder or os.getcwd()),
@@ -173,7 +203,7 @@ def _store(ctl, folder=None):
         "iter": O.iter, "last_read": ctl.last_iter, "runs": _runs(ctl.label),
         "state": ctl.state.to_dict(),
         "contacts": ctl.reader.to_dict(), "zeroed": ctl.zeroing.to_list(),
-        "damped_until": ctl.damping.until, "fast": ctl.schedule.to_list()})
+        "damped_until": ctl.damping.until, "fast": ctl.schedule.to_list()}
 
 
 def _material_reference(material):
@@ -185,10 +215,8 @@ def _material_reference(material):
     return str(source)
 
 
-def _restore(label):
-    if _TAG + label not in O.tags.keys() or not O.tags[_TAG + label]:
-        raise AttachError(f"yadebreak engine '{label}' has no state in this scene")
-    data = json.loads(O.tags[_TAG + label])
+def _restore(label, data):
+    """The controller of a stored state (_state), in the scene loaded now."""
     if any(now > then + 1 for now, then in zip(_runs(label), data["runs"])):
         raise AttachError(
             f"yadebreak's state in this scene was stored at step {data['iter']} and the scene ran "
@@ -238,9 +266,7 @@ def save(path):
 
 def _store_all(folder=None):
     """Every engine's and part's state into O.tags (before O.save)."""
-    for ctl in _ENGINES.values():
-        _store(ctl, folder)
-    protocol.store()
+    protocol.store(folder)
 
 
 def reload(label="yadebreak"):
@@ -255,11 +281,11 @@ def reload(label="yadebreak"):
     list is the order in which forces are summed. Measured: without it a one-ring bed cut at step
     56,100 differed in the last bit from step 56,597 on and ended with 81 damage events against
     88; a one-ulp nudge of one body does the same."""
-    walls = {name: ctl.wall_time for name, ctl in _ENGINES.items()}
+    walls = {name: part.controller.wall_time
+             for name, part in protocol.live(BreakageEngine.kind).items()}
     _store_all()
     O.saveTmp(_RELOAD)
     O.loadTmp(_RELOAD)
-    forget()
     protocol.forget()
     for name, wall_time in walls.items():
         controller_of(name).wall_time = wall_time          # (this process's measure)
@@ -321,10 +347,10 @@ def run_steps(steps):
 
 
 def on_read(label):
-    """Called by the PyRunner after the InteractionLoop."""
-    controller_of(label).step()
+    """The entry point that scenes saved by earlier versions name after the InteractionLoop."""
+    protocol.run(BreakageEngine.kind, label)
 
 
 def on_zero(label):
-    """Called by the PyRunner before the InteractionLoop."""
-    controller_of(label).zero_overlaps()
+    """The entry point that scenes saved by earlier versions name before the InteractionLoop."""
+    protocol.run(Zeroing.kind, label + "_zero")

@@ -70,7 +70,7 @@ class BondPart(protocol.Part):
     def act(self):
         self.watch()
 
-    def to_state(self):
+    def to_state(self, folder=None):
         return {"iter": O.iter, "label": self.label, "watch": self.watch.to_dict()}
 
     @classmethod

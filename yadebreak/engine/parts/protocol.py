@@ -7,7 +7,7 @@ restores it after O.load, in this process or another.
         kind = "mine"                          # its name in the registry and in O.tags
         hook = AFTER_INTERACTIONS
         def act(self): ...
-        def to_state(self): return {...}       # JSON-able
+        def to_state(self, folder=None): return {...}   # JSON-able
         @classmethod
         def from_state(cls, label, period, state): return cls(...)
 
@@ -59,8 +59,9 @@ class Part:
     def act(self):
         raise NotImplementedError
 
-    def to_state(self):
-        """The part's state as a JSON-able dict (period and label are kept beside it)."""
+    def to_state(self, folder=None):
+        """The part's state as a JSON-able dict (its period is kept beside it); `folder`: the
+        saved scene file's, for names of files relative to it (None: the working folder)."""
         return {}
 
     @classmethod
@@ -72,36 +73,44 @@ class Part:
         """The state of a scene saved before this part had its own O.tags key (None: none)."""
         return None
 
+    def current(self):
+        """False if the part has not followed this scene's steps (it is restored from O.tags)."""
+        return True
+
+    def close(self):
+        """The part is dropped from this process (files it holds open are closed)."""
+
+    @classmethod
+    def tag_for(cls, label):
+        """The O.tags key of the part `label` of this kind."""
+        return f"yadebreak_{cls.kind}:{label}"
+
     @property
     def tag(self):
-        return tag_of(self.kind, self.label)
+        return self.tag_for(self.label)
 
 
-def tag_of(kind, label):
-    """The O.tags key of a part."""
-    return f"yadebreak_{kind}:{label}"
-
-
-def install(part):
+def install(part, dead=False):
     """Register `part` in this process and the scene (its state in O.tags) and return its
-    PyRunner, to be put in O.engines where its hook says."""
-    _hold(part)
+    PyRunner, to be put in O.engines where its hook says (`dead`: asleep until woken)."""
+    hold(part)
     save_state(part)
     # updateGlobals=False: YADE would otherwise copy the caller's locals into __main__ after each
     # call (a user's `steps` or `_` changed by O.step() in a function)
     return wrapper.PyRunner(
         command=f"__import__('yadebreak.engine.parts.protocol').engine.parts.protocol."
                 f"run({part.kind!r}, {part.label!r})",
-        iterPeriod=part.period, initRun=True, label=part.label, updateGlobals=False)
+        iterPeriod=part.period, initRun=True, label=part.label, dead=dead, updateGlobals=False)
 
 
-def _hold(part):
+def hold(part):
+    """`part` is this process's part `part.label` of the current scene."""
     _LIVE[part.label] = part
     _SCENE_OF[part.label] = current_scene()
 
 
-def save_state(part):
-    O.tags[part.tag] = json.dumps({**part.to_state(), "period": part.period})
+def save_state(part, folder=None):
+    O.tags[part.tag] = json.dumps({**part.to_state(folder), "period": part.period})
 
 
 def live(kind):
@@ -118,29 +127,43 @@ def run(kind, label):
 
 def part_of(kind, label):
     """The part `label` of the current scene, restored from O.tags first when this process
-    holds none of this scene (after O.load, or a part of an earlier scene)."""
+    holds none that followed this scene (after O.load, or a part of an earlier scene)."""
     part = _LIVE.get(label)
-    if part is None or _SCENE_OF[label] != current_scene():
-        cls, tag = _KINDS[kind], tag_of(kind, label)
+    if part is None or _SCENE_OF[label] != current_scene() or not part.current():
+        cls = _KINDS[kind]
+        tag = cls.tag_for(label)
         data = (json.loads(O.tags[tag]) if tag in O.tags.keys() and O.tags[tag]
                 else cls.legacy_state(label))
         if data is None:
             raise RuntimeError(f"the scene has no state of yadebreak's {kind} part {label!r}: "
                                "save scenes with yadebreak.save or a job's checkpoint")
+        if part is not None:
+            part.close()
         part = cls.from_state(label, data.get("period", 1), data)
-        _hold(part)
+        hold(part)
     return part
 
 
-def store():
-    """Every part of this scene into O.tags with its state now (before O.save)."""
+def store(folder=None):
+    """Every part of this scene into O.tags with its state now (before O.save; `folder`: the
+    scene file's)."""
     scene = current_scene()
     for label, part in _LIVE.items():
         if _SCENE_OF[label] == scene:
-            save_state(part)
+            save_state(part, folder)
 
 
-def forget():
-    """Drop this process's parts: the next run of each rebuilds it from O.tags (after O.load)."""
-    _LIVE.clear()
-    _SCENE_OF.clear()
+def drop(label):
+    """Forget part `label` in this process (detached); returns it, or None."""
+    _SCENE_OF.pop(label, None)
+    part = _LIVE.pop(label, None)
+    if part is not None:
+        part.close()
+    return part
+
+
+def forget(kinds=None):
+    """Drop this process's parts (of `kinds` only, if given): the next run of each rebuilds it
+    from O.tags (after O.load)."""
+    for label in [k for k, p in _LIVE.items() if kinds is None or p.kind in kinds]:
+        drop(label)

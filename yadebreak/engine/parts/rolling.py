@@ -85,7 +85,7 @@ class RollingFriction(protocol.Part):
             phys.kr = STIFFNESS * inertia / dt**2
             self.configured += 1
 
-    def to_state(self):
+    def to_state(self, folder=None):
         """The settings and where the checks are (which check passes over every interaction,
         the counts the next check compares with): a loaded scene configures the contacts at the
         same steps as the saved one would have."""
