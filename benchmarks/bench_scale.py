@@ -195,7 +195,7 @@ def _mill_args(out):
     return Namespace(material="limestone", size=8e-3, ball_size=25e-3, drum_diameter=0.25,
                      drum_length=0.1, lifters=8, lifter_height=10e-3, lifter_width=10e-3,
                      speed=0.75, ball_filling=0.3, ore_filling=0.1, duration=1.0,
-                     stiffness_scale=1e-3, time_step_fraction=0.05, dmin=0.0,
+                     stiffness_scale=1e-3, time_step_fraction=0.05,
                      read_period="fast", seed=1, sample_interval=0.02, vtk_interval=0.0,
                      checkpoint_every=-1.0, resume=False, stop_after=0.0, out=str(out))
 
