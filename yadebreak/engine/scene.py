@@ -123,7 +123,6 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     engines.insert(loop_idx + 1, protocol.install(part))
     engines.insert(loop_idx, protocol.install(Zeroing(label + "_zero"), dead=True))
     O.engines = engines
-    protocol.save_state(part)                # with its runners' counts
     return ctl
 
 
