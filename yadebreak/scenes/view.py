@@ -43,11 +43,6 @@ def velocity(i):
     return tuple(O.bodies[i].state.vel)
 
 
-def mass(i):
-    """Body i's mass (kg)."""
-    return O.bodies[i].state.mass
-
-
 def touching(i):
     """True if body i has an interaction (real or potential: its bounds overlap another's)."""
     return any(O.interactions.withBody(i))
