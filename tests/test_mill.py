@@ -59,7 +59,7 @@ def test_a_short_mill_run_keeps_mass_stays_finite_and_the_motor_does_work(scene,
 
 def test_the_charge_fills_the_drum_as_asked(scene, tmp_path):
     """Fillings are bulk volumes over the drum's volume, the bulk PACKING solid."""
-    from yadebreak.jobs import mill
+    from yadebreak.scenes import mill
     args = _args(tmp_path)
     balls, ores = mill.charge_counts(args)
     volume = math.pi * 0.06 ** 2 * 0.04

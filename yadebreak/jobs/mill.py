@@ -20,9 +20,7 @@ from yadebreak import engine
 from yadebreak.model import milling
 from yadebreak.jobs import paraview
 from yadebreak.scenes import view
-from yadebreak.scenes.mill import (  # noqa: F401 (the job's names of its scene)
-    PACKING, SETTLE_TIME, charge_counts, charge_positions, charge_state, drum_facets, drum_profile,
-    drum_torque, end_walls, mill_scene, mill_time)
+from yadebreak.scenes.mill import charge_state, drum_torque, mill_scene, mill_time
 from yadebreak.jobs import skeleton
 from yadebreak.jobs import options as job_options
 from yadebreak.jobs.options import check_mill_geometry
