@@ -10,7 +10,7 @@ from yadebreak import model
 from yadebreak.criteria.base import Criterion, register
 from yadebreak.model.intervals import PARTICLE_SIZE, YOUNG_MODULUS
 from yadebreak.model.kinds import BREAKABLE
-from yadebreak.model.materials import GLOBAL_DAMPING_KEY, _number, in_file_unit
+from yadebreak.model.materials import GLOBAL_DAMPING_KEY, in_file_unit, read_number
 
 
 @register
@@ -50,9 +50,9 @@ class Tavares(Criterion):
     @staticmethod
     def parse_more(breakage, values, problems):
         """[breakage] device_stiffness (GPa in the file, Pa in `values`)."""
-        dev = _number(breakage, "device_stiffness", "breakage", problems,
-                      *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", required=False,
-                      default=model.DEVICE_STIFFNESS_STEEL / 1e9)
+        dev = read_number(breakage, "device_stiffness", "breakage", problems,
+                          *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", required=False,
+                          default=model.DEVICE_STIFFNESS_STEEL / 1e9)
         values["device_stiffness"] = None if dev is None else dev * 1e9
 
     def with_successive_kappa(self, kappa_successive):
