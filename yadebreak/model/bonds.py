@@ -23,7 +23,7 @@ from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
 from yadebreak.model.intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS
-from yadebreak.model.materials import (MaterialError, _check_keys, _find, _number, _read_table,
+from yadebreak.model.materials import (MaterialError, _check_keys, _find, _read_table, read_number,
                         available_materials, in_file_unit)
 
 #: failure modes, as stored per bond (index) and written in outputs (name)
@@ -111,7 +111,7 @@ def _section(doc, name, keys, problems):
     _check_keys(table, {k[0] for k in keys}, name, problems)
     values = {}
     for key, lo, lo_inc, hi, hi_inc, unit, factor in keys:
-        v = _number(table, key, name, problems, lo, lo_inc, hi, hi_inc, unit)
+        v = read_number(table, key, name, problems, lo, lo_inc, hi, hi_inc, unit)
         values[key] = None if v is None else v * factor
     return values
 

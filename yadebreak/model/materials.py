@@ -249,8 +249,8 @@ def _range_text(lo, lo_inc, hi, hi_inc):
     return f"{left}{lo:g}, {hi_txt}{right}"
 
 
-def _number(table, key, where, problems, lo, lo_inc, hi, hi_inc, unit, required=True,
-            default=None):
+def read_number(table, key, where, problems, lo, lo_inc, hi, hi_inc, unit, required=True,
+                default=None):
     """Read one number, checking type and range; append any problem and return None on failure."""
     if key not in table:
         if required and default is None:
@@ -334,7 +334,7 @@ def _parse_elastic(doc, problems):
     _check_keys(elastic, {k[0] for k in _ELASTIC}, "elastic", problems)
     values = {}
     for key, lo, lo_inc, hi, hi_inc, unit, factor in _ELASTIC:
-        v = _number(elastic, key, "elastic", problems, lo, lo_inc, hi, hi_inc, unit)
+        v = read_number(elastic, key, "elastic", problems, lo, lo_inc, hi, hi_inc, unit)
         values[key] = None if v is None else v * factor
     return values
 
@@ -349,7 +349,7 @@ def _parse_contacts(doc, contact_like, problems):
             problems.append(f"{where}: must be a table")
             continue
         _check_keys(table, {k[0] for k in _CONTACT}, where, problems)
-        got = [_number(table, k, where, problems, lo, li, hi, hi_i, u)
+        got = [read_number(table, k, where, problems, lo, li, hi, hi_i, u)
                for k, lo, li, hi, hi_i, u, _ in _CONTACT]
         if None not in got:
             contacts[other] = ContactParams(*got)
@@ -370,8 +370,8 @@ def _parse_breakage(doc, values, problems):
     allowed = {k[0] for k in criterion.keys} | {"model", "beta", "beta_source"}
     _check_keys(breakage, allowed | criterion.more_keys, "breakage", problems)
     for key, lo, lo_inc, hi, hi_inc, unit, factor in criterion.keys:
-        v = _number(breakage, key, "breakage", problems, lo, lo_inc, hi, hi_inc, unit,
-                    default=criterion.defaults.get(key))
+        v = read_number(breakage, key, "breakage", problems, lo, lo_inc, hi, hi_inc, unit,
+                        default=criterion.defaults.get(key))
         values[key] = None if v is None else v * factor
     criterion.parse_more(breakage, values, problems)
     beta_source = breakage.get("beta_source", "material")
