@@ -62,6 +62,8 @@ class BondPart(protocol.Part):
 
     kind = "bonds"
     hook = protocol.AFTER_NEWTON
+    saved_at_install = False          # the network's dump is stale a step later: saved with
+    #                                   the scene (yadebreak.save, save_checkpoint) only
 
     def __init__(self, label, watch):
         super().__init__(label, 1)

@@ -42,6 +42,10 @@ class Part:
 
     kind: str = ""
     hook: str = AFTER_INTERACTIONS
+    #: its state goes into O.tags when it is installed (so that a scene O.saved without
+    #: yadebreak.save still carries its settings); False for a state valid only at the step it
+    #: was stored, which store() writes with the scene
+    saved_at_install: bool = True
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -94,7 +98,8 @@ def install(part, dead=False):
     """Register `part` in this process and the scene (its state in O.tags) and return its
     PyRunner, to be put in O.engines where its hook says (`dead`: asleep until woken)."""
     hold(part)
-    save_state(part)
+    if part.saved_at_install:
+        save_state(part)
     # updateGlobals=False: YADE would otherwise copy the caller's locals into __main__ after each
     # call (a user's `steps` or `_` changed by O.step() in a function)
     return wrapper.PyRunner(
