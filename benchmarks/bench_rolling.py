@@ -18,6 +18,7 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 from yadebreak import engine, scenes  # noqa: E402
 from yadebreak.adapter.yade_api import O  # noqa: E402
+from yadebreak.engine.parts import protocol  # noqa: E402
 
 QUICK = "--quick" in sys.argv
 STEPS = 3000 if QUICK else 10000
@@ -31,14 +32,16 @@ def _rate(layers, mode):
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 3, layers, 3.05, seed=1)
     for st in brk.bodies.values():
         st.fracture_energy = 1e30
-    part = next(e for e in O.engines if getattr(e, "label", "") == "rolling")
     if mode == "none":                # the same settled bed, without the moment or the part
-        O.engines = [e for e in O.engines if e is not part]
+        protocol.uninstall("rolling")
         loop = next(e for e in O.engines if type(e).__name__ == "InteractionLoop")
         loop.lawDispatcher.functors[0].includeMoment = False
-        part = None
     elif mode == "every step":
-        part.iterPeriod = 1
+        protocol.set_period("rolling", 1)
+    # the runner after Newton's step calls the rolling part alone here: its time is the part's
+    part = (None if mode == "none" else
+            next(e for e in O.engines if getattr(e, "label", "") == protocol.runner_label(
+                protocol.AFTER_NEWTON)))
     while not any(O.interactions.withBody(info["ball"])):       # to the first touch
         engine.run_steps(50)
     scenes.hold_release(info)

@@ -51,7 +51,8 @@ def test_a_part_acts_every_period_and_its_state_survives_save_and_load(scene):
     ip2, _ = add_materials({"ore": "copper_ore"})
     O.bodies.append(utils.sphere((0, 0, 0), 1e-3, material="ore"))
     part = _counter()("counter", period=3)
-    O.engines = scenes.hertz_engines(ip2) + [protocol.install(part)]
+    O.engines = scenes.hertz_engines(ip2)
+    protocol.install(part)
     run_steps(30)
     assert len(part.steps) >= 9 and set(b - a for a, b in zip(part.steps, part.steps[1:])) == {3}
     calls = part.calls
@@ -72,3 +73,45 @@ def test_a_part_with_an_unknown_hook_or_a_taken_kind_is_refused():
         type("Bad", (protocol.Part,), {"kind": "test_bad", "hook": "during_lunch"})
     with pytest.raises(ValueError, match="registered already"):
         type("Again", (protocol.Part,), {"kind": "test_counter"})
+
+
+def test_one_runner_per_hook_calls_each_part_at_its_own_steps(scene):
+    """Two parts after Newton's step, every 2 and every 3 steps, share one PyRunner: each acts at
+    its own steps (the runner runs every step); one asleep leaves the runner the other's period
+    and last step, so YADE waits for it; none awake leaves the runner dead; the last one taken
+    out takes the runner with it."""
+    from yade import utils
+    from yadebreak import scenes
+    from yadebreak.engine import add_materials, run_steps
+    from yadebreak.engine.parts import protocol
+    O = scene
+    ip2, _ = add_materials({"ore": "copper_ore"})
+    O.bodies.append(utils.sphere((0, 0, 0), 1e-3, material="ore"))
+    O.engines = scenes.hertz_engines(ip2)
+    every_2, every_3 = _counter()("two", period=2), _counter()("three", period=3)
+    protocol.install(every_2)
+    protocol.install(every_3)
+    label = protocol.runner_label(protocol.AFTER_NEWTON)
+    runners = [e for e in O.engines if getattr(e, "label", "") == label]
+    assert len(runners) == 1 and type(O.engines[O.engines.index(runners[0]) - 1]).__name__ \
+        == "NewtonIntegrator"
+    run_steps(12)
+    assert every_2.steps == [0, 2, 4, 6, 8, 10] and every_3.steps == [0, 3, 6, 9]
+    runner = runners[0]
+    assert runner.iterPeriod == 1 and runner.nDone == 12
+    protocol.sleep("two")
+    assert runner.iterPeriod == 3 and not runner.dead
+    done = runner.nDone
+    run_steps(6)                                      # steps 12..17: "three" at 12 and 15
+    assert every_3.steps[-2:] == [12, 15] and every_2.steps[-1] == 10
+    assert runner.nDone == done + 2                   # YADE did the waiting
+    protocol.sleep("three")
+    assert runner.dead
+    protocol.wake("two")
+    run_steps(2)
+    assert every_2.steps[-1] == 18 and not runner.dead
+    protocol.uninstall("two")
+    assert runner.dead and protocol.installed("three")      # "three" sleeps still
+    protocol.uninstall("three")
+    assert not any(getattr(e, "label", "") == label for e in O.engines)
+    assert not protocol.installed("two") and not protocol.installed("three")

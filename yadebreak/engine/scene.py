@@ -26,15 +26,23 @@ YADE_DEFAULT_DT = 1e-8
 
 
 class BreakageEngine(protocol.Part):
-    """The engine's read, after the InteractionLoop every `period` steps (the read schedule sets
-    the PyRunner's iterPeriod); its state is the controller's (_state)."""
+    """The engine's read, after the InteractionLoop every `period` steps (the read schedule's:
+    it sets it through protocol.set_period); its state is the controller's (_state)."""
 
     kind = "breakage"
     hook = protocol.AFTER_INTERACTIONS
 
     def __init__(self, label, controller):
-        super().__init__(label, controller.period)
         self.controller = controller
+        super().__init__(label, controller.period)
+
+    @property
+    def period(self):
+        return self.controller.schedule.period
+
+    @period.setter
+    def period(self, steps):
+        self.controller.schedule.period = steps
 
     @classmethod
     def tag_for(cls, label):
@@ -53,7 +61,7 @@ class BreakageEngine(protocol.Part):
 
     @classmethod
     def from_state(cls, label, period, state):
-        return cls(label, _restore(label, state))
+        return cls(label, _restore(label, state, period))
 
     @classmethod
     def legacy_state(cls, label):
@@ -90,7 +98,7 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     config = Config.from_options(seed=seed, **options)
     found = check_mapping(materials)
     _check_event_log(config.output.event_log)
-    if label in protocol.live(BreakageEngine.kind) and find_engine(label) is not None:
+    if label in protocol.live(BreakageEngine.kind) and protocol.installed(label):
         raise AttachError(f"yadebreak is already attached to this scene as '{label}': call attach "
                           "once per scene (or give another label)")
     engines = list(O.engines)
@@ -119,9 +127,8 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     user_dt = None if O.dt == YADE_DEFAULT_DT else O.dt
     ctl.time_step.at_attach(smallest_rayleigh_time(), user_dt)
     ctl.last_iter = O.iter - 1
-    part = BreakageEngine(label, ctl)
-    engines.insert(loop_idx + 1, protocol.install(part))
-    engines.insert(loop_idx, protocol.install(Zeroing(label + "_zero"), dead=True))
+    protocol.install(BreakageEngine(label, ctl), engines)
+    protocol.install(Zeroing(label + "_zero"), engines, awake=False)
     O.engines = engines
     return ctl
 
@@ -147,7 +154,7 @@ def _check_not_tracked_elsewhere(label, ids):
     """One engine per body: a second label over bodies another one tracks would judge and break
     them twice."""
     for other, part in protocol.live(BreakageEngine.kind).items():
-        if other == label or find_engine(other) is None:
+        if other == label or not protocol.installed(other):
             continue
         shared = sorted(set(ids) & set(part.controller.bodies))
         if shared:
@@ -159,9 +166,8 @@ def _check_not_tracked_elsewhere(label, ids):
 def detach(label="yadebreak"):
     """Remove the engine `label` from the scene (its PyRunners, its saved state); returns its
     controller, whose events and results stay readable."""
-    part = protocol.drop(label)               # its controller closed
-    protocol.drop(label + "_zero")
-    O.engines = [e for e in O.engines if getattr(e, "label", "") not in (label, label + "_zero")]
+    part = protocol.uninstall(label)          # its controller closed
+    protocol.uninstall(label + "_zero")
     for tag in (BreakageEngine.tag_for(label), Zeroing.tag_for(label + "_zero")):
         if tag in O.tags.keys():
             O.tags[tag] = ""                   # O.tags cannot delete a key
@@ -181,10 +187,10 @@ def controller_of(label="yadebreak"):
 
 
 def _runs(label):
-    """How many times the engine's two PyRunners have run. The state stored with the scene is
-    current only if neither has run since, but for the call that restores it (YADE counts a
-    run before the runner's command)."""
-    return [getattr(find_engine(name), "nDone", 0) for name in (label, label + "_zero")]
+    """How many times the runners of the engine's two parts have run. The state stored with the
+    scene is current only if neither has run since, but for the call that restores it (YADE
+    counts a run before the runner's command)."""
+    return [protocol.runs(BreakageEngine.kind, label), protocol.runs(Zeroing.kind, label + "_zero")]
 
 
 def _state(ctl, folder=None):
@@ -214,7 +220,7 @@ def _material_reference(material):
     return str(source)
 
 
-def _restore(label, data):
+def _restore(label, data, period):
     """The controller of a stored state (_state), in the scene loaded now."""
     if any(now > then + 1 for now, then in zip(_runs(label), data["runs"])):
         raise AttachError(
@@ -226,8 +232,8 @@ def _restore(label, data):
                               config.criteria.emax_ratio)
     state = EngineState.from_dict(data["state"], config.output.event_log)
     ctl = Controller(label, config, scene_materials, data["materials"], state)
-    engine = find_engine(label)
-    ctl.schedule.period = engine.iterPeriod if engine is not None else 1
+    own = find_engine(label)                  # a PyRunner of its own (older scenes)
+    ctl.schedule.period = own.iterPeriod if own is not None else period
     ctl.schedule.restore(data["fast"])
     ctl.reader.restore(data["contacts"])
     ctl.zeroing.restore(data["zeroed"])

@@ -7,7 +7,8 @@ import math
 
 from yadebreak.model import placement
 from yadebreak.options.table import AttachError
-from yadebreak.adapter.yade_api import O, find_engine, utils, wrapper
+from yadebreak.adapter.yade_api import O, utils, wrapper
+from yadebreak.engine.parts import protocol
 
 #: read_period="fast" never waits longer than this many steps between reads.
 FAST_MAX_PERIOD = 200
@@ -89,7 +90,7 @@ class Reach:
 class ReadSchedule:
     """How many steps to the next read: a fixed k, "auto" (k dt <= read_fraction of the Rayleigh
     time of the smallest breakable body) or "fast" (as often as the loading requires). The
-    period is the PyRunner's iterPeriod."""
+    period is the engine part's (protocol.set_period)."""
 
     def __init__(self, options, engine_label, smallest, reach=None):
         self.options = options                # config.Reading
@@ -163,7 +164,7 @@ class ReadSchedule:
     def set_period(self, k):
         if k != self.period:
             self.period = k
-            find_engine(self.engine_label).iterPeriod = k
+            protocol.set_period(self.engine_label, k)
 
     def remedies(self):
         """What makes reads closer, best first, for the warning that a read came late: (option

@@ -16,7 +16,8 @@ than with a visit every step (tolerance 0), and never harder.
 """
 from __future__ import annotations
 
-from yadebreak.adapter.yade_api import O, Vector3, find_engine, utils, wrapper
+from yadebreak.adapter.yade_api import O, Vector3, utils, wrapper
+from yadebreak.engine.parts import protocol
 
 #: a slack pair sleeps at most this many steps
 MAX_SLEEP = 50
@@ -98,13 +99,13 @@ class OverlapZeroing:
 
     def wake(self):
         if self.pairs:
-            find_engine(self.engine_label).dead = False
+            protocol.wake(self.engine_label)
 
     def apply(self):
         """Before the InteractionLoop: scale kno, kso of every zeroed pair awake (sphere pairs
         and spheres on walls from this step's positions, facets from the last step's overlap)."""
         if not self.pairs:
-            find_engine(self.engine_label).dead = True
+            protocol.sleep(self.engine_label)
             return
         now = O.iter
         woken = self._wake(now)

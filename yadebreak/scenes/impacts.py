@@ -12,7 +12,7 @@ import numpy as np
 # the coupling makes yade importable from Debian's python3 first
 from yadebreak.model import placement
 from yadebreak.engine import add_materials, attach, run_steps
-from yadebreak.engine.parts.rolling import rolling_engine
+from yadebreak.engine.parts.rolling import install_rolling
 from yadebreak.adapter.yade_api import O, utils, wrapper as _w
 from yadebreak.process.files import append_whole
 from yadebreak.process.signals import stop_point, stop_points
@@ -35,7 +35,7 @@ def hertz_engines(ip2, gravity=(0.0, 0.0, 0.0), facets=False, rolling=None):
         _w.NewtonIntegrator(damping=0.0, gravity=gravity, label="newton"),
     ]
     if rolling is not None:
-        engines.append(rolling_engine(rolling))
+        install_rolling(rolling, engines)
     return engines
 
 

@@ -52,7 +52,7 @@ def attach_bonds(ids, pairs, lengths, radii, binder, rng, target_id=None, check_
     time_scale = bonds.bond_time_scale(masses, 0.4 * masses * radii**2, pairs,
                                        network.stiffness, network.lever_a, network.lever_b)
     watch = BondWatch(network, target_id, check_period=check_period)
-    O.engines = O.engines + [protocol.install(BondPart(LABEL, watch))]
+    protocol.install(BondPart(LABEL, watch))
     return watch, time_scale
 
 

@@ -11,22 +11,26 @@ restores it after O.load, in this process or another.
         @classmethod
         def from_state(cls, label, period, state): return cls(...)
 
-    O.engines = O.engines + [install(Mine(...))]   # the PyRunner that calls it
+    install(Mine("mine", period=5))            # after O.engines is set (or into a list of engines)
 
-Adding a part is one file with its class. A PyRunner calls `run(label)`, which finds the part
-in this process or restores it from the scene's O.tags (`yadebreak_<kind>:<label>`); `store()`
-writes every part of the scene into O.tags before O.save, `forget()` drops this process's parts
-(after O.load, the next run restores them). One PyRunner per part keeps YADE's iterPeriod doing
-the waiting: Python in YADE's loop costs a few microseconds per call, so a part due every k
-steps costs nothing on the other k - 1.
+Adding a part is one file with its class. One PyRunner per hook point (`yadebreak_<hook>`: just
+before or after the InteractionLoop, or after NewtonIntegrator) calls the parts due there, in the
+order they were installed; its members are listed in O.tags (`yadebreak_hook:<hook>`), each
+part's state under its own key (`yadebreak_<kind>:<label>`), so that a loaded scene finds them
+again. YADE's iterPeriod still does the waiting: while one part is awake at a hook, the runner's
+period and last step are that part's (Python in YADE's loop costs a few microseconds a call, so
+a part due every k steps costs nothing on the other k - 1); parts due at different steps make it
+run every step. A part asleep (`sleep`) costs nothing; with none awake the runner is dead.
+Scenes saved by earlier versions have a PyRunner per part, labelled as the part, whose command
+calls `run(kind, label)`: they keep running as they were saved.
 """
 from __future__ import annotations
 
 import json
 
-from yadebreak.adapter.yade_api import O, current_scene, wrapper
+from yadebreak.adapter.yade_api import O, current_scene, find_engine, wrapper
 
-#: where in YADE's loop a part's PyRunner stands
+#: where in YADE's loop a part's runner stands
 BEFORE_INTERACTIONS = "before_interactions"
 AFTER_INTERACTIONS = "after_interactions"
 AFTER_NEWTON = "after_newton"
@@ -35,10 +39,12 @@ HOOKS = (BEFORE_INTERACTIONS, AFTER_INTERACTIONS, AFTER_NEWTON)
 _KINDS: dict[str, type] = {}              # kind -> Part subclass
 _LIVE: dict[str, "Part"] = {}             # label -> this process's part
 _SCENE_OF: dict[str, object] = {}         # label -> the scene its part belongs to
+_MEMBERS: dict[str, tuple] = {}           # hook -> (scene, [(kind, label), ...]) read from O.tags
 
 
 class Part:
-    """One piece of work in YADE's loop; `label` names its PyRunner, `period` its steps."""
+    """One piece of work in YADE's loop; `label` names it, `period` its steps; `awake` False: it
+    waits for wake(); `last`: the step it last acted at (None: never)."""
 
     kind: str = ""
     hook: str = AFTER_INTERACTIONS
@@ -59,13 +65,16 @@ class Part:
     def __init__(self, label, period=1):
         self.label = label
         self.period = int(period)
+        self.awake = True
+        self.last = None
 
     def act(self):
         raise NotImplementedError
 
     def to_state(self, folder=None):
-        """The part's state as a JSON-able dict (its period is kept beside it); `folder`: the
-        saved scene file's, for names of files relative to it (None: the working folder)."""
+        """The part's state as a JSON-able dict (its period, last step and whether it is awake
+        are kept beside it); `folder`: the saved scene file's, for names of files relative to
+        it (None: the working folder)."""
         return {}
 
     @classmethod
@@ -94,18 +103,72 @@ class Part:
         return self.tag_for(self.label)
 
 
-def install(part, dead=False):
-    """Register `part` in this process and the scene (its state in O.tags) and return its
-    PyRunner, to be put in O.engines where its hook says (`dead`: asleep until woken)."""
+def runner_label(hook):
+    """The label of the PyRunner that calls the parts of `hook`."""
+    return f"yadebreak_{hook}"
+
+
+def install(part, engines=None, awake=True):
+    """Register `part` in this process and the scene (its state in O.tags) and add it to its
+    hook's runner in `engines` (a list of engines about to be O.engines; None: O.engines, set
+    again), which gets the runner where the hook says if it has none. Returns the engines."""
+    target = list(O.engines) if engines is None else engines
+    part.awake = bool(awake)
     hold(part)
+    members = _members(part.hook) if _find(target, runner_label(part.hook)) else []
+    if any(label == part.label for _, label in members):
+        raise ValueError(f"a part labelled {part.label!r} is installed already")
+    _set_members(part.hook, members + [(part.kind, part.label)])
     if part.saved_at_install:
         save_state(part)
+    runner = _find(target, runner_label(part.hook)) or _add_runner(target, part.hook)
+    _time(runner, part.hook)
+    if engines is None:
+        O.engines = target
+    return target
+
+
+def _add_runner(engines, hook):
+    """The hook's runner, put in `engines` where the hook says."""
     # updateGlobals=False: YADE would otherwise copy the caller's locals into __main__ after each
     # call (a user's `steps` or `_` changed by O.step() in a function)
-    return wrapper.PyRunner(
+    runner = wrapper.PyRunner(
         command=f"__import__('yadebreak.engine.parts.protocol').engine.parts.protocol."
-                f"run({part.kind!r}, {part.label!r})",
-        iterPeriod=part.period, initRun=True, label=part.label, dead=dead, updateGlobals=False)
+                f"run_hook({hook!r})",
+        iterPeriod=1, initRun=True, label=runner_label(hook), updateGlobals=False)
+    kind = wrapper.NewtonIntegrator if hook == AFTER_NEWTON else wrapper.InteractionLoop
+    at = next((k for k, e in enumerate(engines) if isinstance(e, kind)), None)
+    if at is None:
+        raise ValueError(f"O.engines has no {kind.__name__}: a part {hook} is installed after "
+                         "O.engines is set")
+    engines.insert(at if hook == BEFORE_INTERACTIONS else at + 1, runner)
+    return runner
+
+
+def uninstall(label):
+    """Take part `label` out of the scene's engines (its runner goes when it was the last one
+    there) and out of this process; returns the part, or None."""
+    for hook in HOOKS:
+        members = _members(hook)
+        if any(name == label for _, name in members):
+            rest = [(kind, name) for kind, name in members if name != label]
+            _set_members(hook, rest)
+            runner = find_engine(runner_label(hook))
+            if not rest:
+                O.engines = [e for e in O.engines if e is not runner
+                             and getattr(e, "label", "") != runner_label(hook)]
+            elif runner is not None:
+                _time(runner, hook)
+    if find_engine(label) is not None:                 # a runner of its own (older scenes)
+        O.engines = [e for e in O.engines if getattr(e, "label", "") != label]
+    return drop(label)
+
+
+def installed(label):
+    """Whether part `label` is in this scene's engines."""
+    return find_engine(label) is not None or any(
+        find_engine(runner_label(hook)) is not None
+        and any(name == label for _, name in _members(hook)) for hook in HOOKS)
 
 
 def hold(part):
@@ -115,7 +178,8 @@ def hold(part):
 
 
 def save_state(part, folder=None):
-    O.tags[part.tag] = json.dumps({**part.to_state(folder), "period": part.period})
+    O.tags[part.tag] = json.dumps({**part.to_state(folder), "period": part.period,
+                                   "last": part.last, "awake": part.awake})
 
 
 def live(kind):
@@ -125,9 +189,94 @@ def live(kind):
             if p.kind == kind and _SCENE_OF[label] == scene}
 
 
+def run_hook(hook):
+    """Called by a hook's runner: every awake part there whose period has passed acts."""
+    now = O.iter
+    for kind, label in _members(hook):
+        part = part_of(kind, label)
+        if part.awake and (part.last is None or now - part.last >= part.period):
+            part.last = now
+            part.act()
+
+
 def run(kind, label):
-    """Called by a part's PyRunner: the part acts (see part_of)."""
-    part_of(kind, label).act()
+    """Called by a part's own PyRunner (scenes saved by earlier versions): the part acts."""
+    part = part_of(kind, label)
+    part.last = O.iter
+    part.act()
+
+
+def set_period(label, period):
+    """Part `label` acts every `period` steps from its last step on."""
+    _change(label, period=int(period))
+
+
+def wake(label):
+    """Part `label` acts again (from the next step its period allows)."""
+    _change(label, awake=True)
+
+
+def sleep(label):
+    """Part `label` does not act until woken; a runner with no part awake is dead."""
+    _change(label, awake=False)
+
+
+def _change(label, **values):
+    """Part `label`'s period or wakefulness, and its runner's timing with it."""
+    part = _named(label)
+    if part is None:                                   # not restored (older scenes' own runner)
+        own = find_engine(label)
+        if own is not None and "awake" in values:
+            own.dead = not values["awake"]
+        elif own is not None:
+            own.iterPeriod = values["period"]
+        return
+    for k, v in values.items():
+        setattr(part, k, v)
+    own = find_engine(part.label)                      # a runner of its own (older scenes)
+    if own is not None:
+        own.iterPeriod, own.dead = part.period, not part.awake
+        return
+    runner = find_engine(runner_label(part.hook))
+    if runner is not None:
+        _time(runner, part.hook)
+
+
+def _named(label):
+    """This scene's part `label` (restored if it must be), or None if the scene lists none."""
+    part = _LIVE.get(label)
+    if part is not None and _SCENE_OF[label] == current_scene():
+        return part
+    for hook in HOOKS:
+        for kind, name in _members(hook):
+            if name == label:
+                return part_of(kind, label)
+    return None
+
+
+def runs(kind, label):
+    """How many times the runner of part `label` has run (YADE's nDone; 0 if none)."""
+    runner = find_engine(label) or find_engine(runner_label(_KINDS[kind].hook))
+    return getattr(runner, "nDone", 0)
+
+
+def _time(runner, hook):
+    """The runner's period: its one awake part's (with that part's last step, so that YADE
+    waits for it), 1 if the awake parts are due at different steps; dead if none is awake."""
+    parts = [_LIVE.get(label) for _, label in _members(hook)]
+    if any(p is None for p in parts):                  # not restored yet: every step
+        runner.dead, runner.iterPeriod = False, 1
+        return
+    awake = [p for p in parts if p.awake]
+    runner.dead = not awake
+    steps = {(p.period, p.last) for p in awake}
+    if len(steps) != 1:
+        runner.iterPeriod = 1
+        return
+    period, last = steps.pop()
+    runner.iterPeriod = period
+    if last is not None and runner.nDone:
+        runner.iterLast = last
 
 
 def part_of(kind, label):
@@ -145,8 +294,29 @@ def part_of(kind, label):
         if part is not None:
             part.close()
         part = cls.from_state(label, data.get("period", 1), data)
+        part.last, part.awake = data.get("last"), data.get("awake", True)
         hold(part)
     return part
+
+
+def _members(hook):
+    """The (kind, label) of the parts at `hook` in this scene, in calling order."""
+    scene = current_scene()
+    cached = _MEMBERS.get(hook)
+    if cached is None or cached[0] != scene:
+        key = f"yadebreak_hook:{hook}"
+        text = O.tags[key] if key in O.tags.keys() else ""
+        cached = _MEMBERS[hook] = (scene, [tuple(m) for m in json.loads(text or "[]")])
+    return cached[1]
+
+
+def _set_members(hook, members):
+    O.tags[f"yadebreak_hook:{hook}"] = json.dumps([list(m) for m in members])
+    _MEMBERS[hook] = (current_scene(), list(members))
+
+
+def _find(engines, label):
+    return next((e for e in engines if getattr(e, "label", "") == label), None)
 
 
 def store(folder=None):
@@ -172,3 +342,5 @@ def forget(kinds=None):
     from O.tags (after O.load)."""
     for label in [k for k, p in _LIVE.items() if kinds is None or p.kind in kinds]:
         drop(label)
+    if kinds is None:
+        _MEMBERS.clear()

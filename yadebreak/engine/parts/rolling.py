@@ -100,11 +100,11 @@ class RollingFriction(protocol.Part):
         return part
 
 
-def rolling_engine(mu, period=DEFAULT_PERIOD, label="rolling"):
-    """The PyRunner that applies rolling friction `mu` ({(material id, id): mu_r}) every `period`
-    steps (after Newton's step); its settings travel in O.tags, so that a saved scene finds them
-    again."""
-    return protocol.install(RollingFriction(mu, period, label))
+def install_rolling(mu, engines=None, period=DEFAULT_PERIOD, label="rolling"):
+    """Rolling friction `mu` ({(material id, id): mu_r}) applied every `period` steps after
+    Newton's step, in `engines` (a list about to be O.engines; None: O.engines); its settings
+    travel in O.tags, so that a saved scene finds them again. Returns the engines."""
+    return protocol.install(RollingFriction(mu, period, label), engines)
 
 
 def on_step(label):
