@@ -9,11 +9,11 @@ breakage); base.py states what a criterion answers and keeps the registry.
 Adding a criterion is one file here: a Criterion subclass decorated with base.register, imported
 below (which registers it; `import yadebreak` imports this package).
 """
-from yadebreak.criteria.base import Criterion, criterion_class, criterion_for, register
+from yadebreak.criteria.base import Criterion, criterion_class, register
 from yadebreak.criteria.judgement import Judgement, judge_all
 from yadebreak.criteria.tavares import Tavares
 from yadebreak.criteria.ab_t10 import AbT10
-from yadebreak.criteria.recording import Recording
+from yadebreak.criteria.recording import Recording, criterion_for
 
 __all__ = ["Criterion", "register", "criterion_class", "criterion_for", "Judgement", "judge_all",
            "Tavares", "AbT10", "Recording"]

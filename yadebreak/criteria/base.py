@@ -112,16 +112,3 @@ def criterion_class(name):
     if name not in CRITERIA:
         raise ValueError(f"criterion = {name!r}: accepted {', '.join(map(repr, CRITERIA))}")
     return CRITERIA[name]
-
-
-def criterion_for(material, breakage=True, kappa_successive=None):
-    """The criterion of a breakable Material for the engine: material.criterion itself (the
-    object the model side uses), with Eq. 8's kappa of fragments when kappa_successive is given
-    (Tavares; None: the material's), wrapped in Recording when breakage=False."""
-    criterion = material.criterion
-    if kappa_successive is not None:
-        criterion = criterion.with_successive_kappa(kappa_successive)
-    if breakage:
-        return criterion
-    from yadebreak.criteria.recording import Recording
-    return Recording(criterion)

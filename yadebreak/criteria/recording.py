@@ -102,3 +102,15 @@ class Recording(Criterion):
 
     def force(self, table, i, ratio):
         return self.inner.force(table, i, ratio)
+
+
+def criterion_for(material, breakage=True, kappa_successive=None):
+    """The criterion of a breakable Material for the engine: material.criterion itself (the
+    object the model side uses), with Eq. 8's kappa of fragments when kappa_successive is given
+    (Tavares; None: the material's), wrapped in Recording when breakage=False."""
+    criterion = material.criterion
+    if kappa_successive is not None:
+        criterion = criterion.with_successive_kappa(kappa_successive)
+    if breakage:
+        return criterion
+    return Recording(criterion)
