@@ -142,3 +142,46 @@ def test_interval_zero_writes_no_series_and_a_bad_one_is_refused(scene, tmp_path
     with pytest.raises(ValueError, match=">= 0 s"):
         paraview.series(tmp_path / "bad", None, -1.0)
 
+
+
+def test_polyhedra_are_written_face_by_face_with_their_bodies_fields(scene, tmp_path):
+    """A scene with a rotated 10 mm cube and a tetrahedron: polyhedra_0000.vtp holds their 6 + 4
+    faces over 8 + 4 points; the points of each body are where YADE has its vertices (their hull
+    has the body's volume and its centroid at the body's position) and every face carries its
+    body's id, volume and velocity; a sphere scene writes no polyhedra file."""
+    from yade import Quaternion, polyhedra_utils, wrapper
+    from yadebreak.jobs import paraview
+    from yadebreak.model.cells import convex_polyhedron
+    O = scene
+    mat = wrapper.PolyhedraMat(young=1e9, poisson=0.25, density=2700.0)
+    O.materials.append(mat)
+    side = 0.01
+    cube = polyhedra_utils.polyhedra(mat, v=[(x, y, z) for x in (0, side) for y in (0, side)
+                                             for z in (0, side)])
+    cube.state.ori = Quaternion((1.0, 2.0, 3.0), 0.7)
+    cube.state.vel = (1.0, -2.0, 0.5)
+    tetra = polyhedra_utils.polyhedra(mat, v=[(0.02, 0, 0), (0.03, 0, 0), (0.02, 0.01, 0),
+                                              (0.02, 0, 0.01)])
+    ids = [O.bodies.append(cube), O.bodies.append(tetra)]
+    paraview.ParaviewSeries(tmp_path / "poly", None, 1e-3)
+    piece = ET.parse(tmp_path / "poly" / "polyhedra_0000.vtp").getroot().find(".//Piece")
+    assert (piece.get("NumberOfPolys"), piece.get("NumberOfPoints")) == ("10", "12")
+    points = np.array(piece.find("Points/DataArray").text.split(), float).reshape(-1, 3)
+    cells = {a.get("Name"): np.array(a.text.split(), float) for a in piece.find("CellData")}
+    connectivity = np.array(piece.find("Polys/DataArray[@Name='connectivity']").text.split(), int)
+    offsets = np.array(piece.find("Polys/DataArray[@Name='offsets']").text.split(), int)
+    faces = np.split(connectivity, offsets[:-1])
+    for bid in ids:
+        body = O.bodies[bid]
+        own = np.unique(np.concatenate([f for f, owner in zip(faces, cells["id"]) if owner == bid]))
+        hull = convex_polyhedron(points[own])
+        assert hull.volume == pytest.approx(body.shape.GetVolume(), rel=1e-9)
+        assert np.allclose(hull.centroid, tuple(body.state.pos), rtol=0, atol=1e-12)
+        mine = cells["id"] == bid
+        assert np.all(cells["volume"][mine] == pytest.approx(body.shape.GetVolume(), rel=1e-9))
+        velocity = cells["velocity"].reshape(-1, 3)[mine]
+        assert np.allclose(velocity, tuple(body.state.vel))
+    assert read_pvd(tmp_path / "poly" / "polyhedra.pvd") == [(0.0, "polyhedra_0000.vtp")]
+    O.reset()
+    paraview.ParaviewSeries(tmp_path / "spheres_only", None, 1e-3)
+    assert not list((tmp_path / "spheres_only").glob("polyhedra*"))

@@ -10,6 +10,10 @@ Files (XML VTK in ASCII, so any XML parser reads them; docs/outputs.md lists eve
   spheres.pvd, spheres_NNNN.vtp    one frame per file: a point with a vertex cell per sphere and
                                    its id, radius, velocity, fracture_energy, damage, class and
                                    generation (the ball is a sphere of class 0)
+  polyhedra.pvd, polyhedra_NNNN.vtp   in scenes with polyhedra, from the first frame that has
+                                   one: each polyhedron's faces as polygons, each face with its
+                                   body's id, volume, velocity, fracture_energy, damage, class
+                                   and generation
   surfaces.pvd, surfaces_NNNN.vtp  walls as square patches sized to the bed, facets as triangles;
                                    a new file only when they change (the bed's holder goes at the
                                    first touch), earlier frames name the same file
@@ -76,6 +80,7 @@ class ParaviewSeries:
         self._sphere_arrays = sphere_arrays
         self._surfaces = None             # ((points, polygons, ids), file) last written
         self.frames = []                  # (time, spheres file, surfaces file)
+        self.polyhedra_frames = []        # (time, polyhedra file), from the first with one
         if resume:
             self._keep_frames_until(view.now())
         else:
@@ -110,6 +115,27 @@ class ParaviewSeries:
         self.frames.append((float(view.now()), spheres, surfaces))
         write_atomic(self.folder / "spheres.pvd", _pvd([(t, s) for t, s, _ in self.frames]))
         write_atomic(self.folder / "surfaces.pvd", _pvd([(t, s) for t, _, s in self.frames]))
+        self._polyhedra_frame(k)
+
+    def _polyhedra_frame(self, k):
+        """Frame k's polyhedra, once the scene has had one (a sphere scene writes none)."""
+        found = view.polyhedra()
+        if not len(found.ids) and not self.polyhedra_frames:
+            return
+        name = f"polyhedra_{k:04d}.vtp"
+        columns = self._body_columns(found.ids)
+        arrays = [("id", found.ids, "Int64"), ("volume", found.volume, "Float64"),
+                  ("velocity", found.vel, "Float64"),
+                  ("fracture_energy", columns["fracture_energy"], "Float64"),
+                  ("damage", columns["damage"], "Float64"),
+                  ("class", columns["class"], "Int32"),
+                  ("generation", columns["generation"], "Int32")]
+        per_face = [(name_, np.asarray(values)[found.owner], kind)
+                    for name_, values, kind in arrays]
+        write_atomic(self.folder / name, _polydata(found.points, per_face, "CellData",
+                                                   found.faces))
+        self.polyhedra_frames.append((float(view.now()), name))
+        write_atomic(self.folder / "polyhedra.pvd", _pvd(self.polyhedra_frames))
 
     # -- spheres ---------------------------------------------------------------------------------
     def _spheres_vtp(self):
@@ -201,6 +227,8 @@ class ParaviewSeries:
         """Reload the frames of an interrupted run written up to `now` (s); remove later ones."""
         spheres, surfaces = (_read_pvd(self.folder / name) for name in ("spheres.pvd", "surfaces.pvd"))
         self.frames = [(t, s, f) for (t, s), (_, f) in zip(spheres, surfaces) if t <= now]
+        self.polyhedra_frames = [(t, f) for t, f in _read_pvd(self.folder / "polyhedra.pvd")
+                                 if t <= now]
         self._remove_files(len(self.frames), {f for _, _, f in self.frames})
         if self.frames:                   # surfaces unchanged since: that file goes on
             last = self.folder / self.frames[-1][2]
@@ -209,11 +237,14 @@ class ParaviewSeries:
                 self._surfaces = (geometry, last.name)
 
     def _remove_files(self, first_kept_out, surfaces_kept=()):
-        """Frame files of an earlier run not in this series: spheres_k for k >= first_kept_out and
-        surface files not kept (an older, longer run would otherwise leave stray frames)."""
-        for path in self.folder.glob("spheres_*.vtp"):
+        """Frame files of an earlier run not in this series: spheres_k and polyhedra_k for k >=
+        first_kept_out and surface files not kept (an older, longer run would otherwise leave
+        stray frames)."""
+        for path in [*self.folder.glob("spheres_*.vtp"), *self.folder.glob("polyhedra_*.vtp")]:
             if int(path.stem.split("_")[1]) >= first_kept_out:
                 path.unlink()
+        if first_kept_out == 0:
+            (self.folder / "polyhedra.pvd").unlink(missing_ok=True)
         for path in self.folder.glob("surfaces_*.vtp"):
             if path.name not in surfaces_kept:
                 path.unlink()

@@ -111,6 +111,37 @@ def finest_sphere_size():
     return float(2.0 * radius.min()) if len(radius) else float("nan")
 
 
+class Polyhedra(NamedTuple):
+    """The scene's polyhedra, in body order: ids, velocities, and each one's faces as polygons
+    over the points of all of them (its vertices where they are now)."""
+    ids: np.ndarray         # (n,)
+    vel: np.ndarray         # (n, 3) m/s
+    volume: np.ndarray      # (n,) m^3
+    points: np.ndarray      # (m, 3) m: every polyhedron's vertices, one after the other
+    faces: list             # [[point index, ...]] every polyhedron's faces, one after the other
+    owner: np.ndarray       # (number of faces,) the index into ids of each face's polyhedron
+
+
+def polyhedra():
+    """The scene's polyhedra (Polyhedra); no polyhedra: empty arrays."""
+    ids, vel, volume, points, faces, owner = [], [], [], [], [], []
+    for b in O.bodies:
+        if b is None or not isinstance(b.shape, wrapper.Polyhedra):
+            continue
+        first = len(points)
+        pos, ori = b.state.pos, b.state.ori
+        points.extend(tuple(pos + ori * v) for v in b.shape.v)
+        for face in b.shape.GetSurfaces():
+            faces.append([first + int(k) for k in face])
+            owner.append(len(ids))
+        ids.append(b.id)
+        vel.append(tuple(b.state.vel))
+        volume.append(b.shape.GetVolume())
+    return Polyhedra(np.array(ids, np.int64), np.array(vel, float).reshape(-1, 3),
+                     np.array(volume, float), np.array(points, float).reshape(-1, 3), faces,
+                     np.array(owner, np.int64))
+
+
 class Surface(NamedTuple):
     """A facet (its corners) or a wall (its axis and position along it) of the scene."""
     id: int
