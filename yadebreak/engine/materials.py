@@ -16,10 +16,10 @@ from yadebreak.engine.parts.rolling import share_pairs as share_rolling_pairs
 from yadebreak.engine.state import Breakable
 
 
-def _frict_material(mat: Material, label: str, stiffness_scale: float = 1.0):
+def _frict_material(mat: Material, label: str, stiffness_scale: float = 1.0, kind="FrictMat"):
     contact = mat.contacts.get("self") or next(iter(mat.contacts.values()), None)
     friction = contact.friction if contact else 0.5
-    return wrapper.FrictMat(young=mat.young_modulus * stiffness_scale, poisson=mat.poisson_ratio,
+    return getattr(wrapper, kind)(young=mat.young_modulus * stiffness_scale, poisson=mat.poisson_ratio,
                             density=mat.density, frictionAngle=math.atan(friction), label=label)
 
 
@@ -47,17 +47,20 @@ def _as_material(name):
         raise AttachError(str(exc)) from None
 
 
-def add_materials(labels, stiffness_scale=1.0):
+def add_materials(labels, stiffness_scale=1.0, kinds=None):
     """Create one YADE FrictMat per label from material files and return the Hertz-Mindlin
     Ip2 functor with restitution and friction per pair (paper Table 6) through MatchMaker.
 
     labels: {"ore": "copper_ore", "steel": "steel"}. stiffness_scale multiplies every Young's
-    modulus, which keeps the ratios of Eq. 4. Returns (ip2, {label: Material}).
+    modulus, which keeps the ratios of Eq. 4. kinds: {label: YADE material class name} for labels
+    that are not FrictMat (a "PolyhedraMat", a FrictMat subclass, for polyhedra: the same Ip2
+    serves them). Returns (ip2, {label: Material}).
     """
     mats, ids = {}, {}
     for label, name in labels.items():
         mats[label] = _as_material(name)
-        frict = _frict_material(mats[label], label, stiffness_scale)
+        frict = _frict_material(mats[label], label, stiffness_scale,
+                                (kinds or {}).get(label, "FrictMat"))
         check_physical(frict, f"material '{label}' ({mats[label].source}) with stiffness_scale = "
                               f"{stiffness_scale:g}")
         ids[label] = O.materials.append(frict)
