@@ -14,10 +14,10 @@ from yadebreak import load_material, scenes
 ENERGY = 1000.0                  # J/kg: every 29 mm copper-ore particle breaks (model: 100 %)
 
 
-def _primary(break_at, read_period="fast"):
+def _primary(break_at, read_period="fast", **options):
     tally, _ = scenes.single_impacts("copper_ore", 0.029, float(np.sqrt(2 * ENERGY)), 4, 4, 3,
                                      time_step_fraction=0.02, break_at=break_at,
-                                     read_period=read_period)
+                                     read_period=read_period, **options)
     return tally.broken
 
 
@@ -46,3 +46,27 @@ def test_at_the_threshold_each_particle_breaks_at_its_fracture_energy():
     # the same particles (same seed, same fracture energies): breaking later means more energy
     assert np.mean([e["ratio"] for e in _primary("peak")]) > 1.5 * np.mean(
         [e["ratio"] for e in broken])
+
+
+def test_t10_energy_e50b_gives_eq7_over_e50b_of_the_energy_absorbed_at_the_break():
+    """attach(t10_energy="e50b") (Rocky's "Median Specific Fracture Energy (e50b)", its Eqs.
+    2-47 and 2-48): each breakage's t10' is A (1 - exp(-b' e / E50b)), e the specific energy the
+    particle absorbed at the break, E50b the median fracture energy of the particles of its size
+    that break at e (the truncated lognormal of Eqs. 2-3 below e), computed here from the
+    equations. Since E50b < e, it is finer than the t10' the default ("particle": Eq. 8 at
+    Ek'/(m E) about 1, near Eq. 9's) gives the same particles."""
+    from yadebreak import model
+    cu = load_material("copper_ore")
+    broken = _primary("threshold", "every_step", t10_energy="e50b")
+    default = {e["id"]: e for e in _primary("threshold", "every_step")}
+    assert len(broken) == 4
+    for e in broken:
+        size = 2.0 * e["radius"]
+        e50 = model.median_fracture_energy(size, cu.e_inf, cu.d0, cu.phi, cu.hertz_stiffness,
+                                           cu.device_stiffness)
+        e50b = model.median_fracture_energy_broken(e["specific_energy"], e50, cu.sigma,
+                                                   cu.emax_ratio)
+        assert e50b < e["specific_energy"]
+        expected = cu.A * (1.0 - np.exp(-cu.b_prime * e["specific_energy"] / e50b))
+        assert e["t10"] == pytest.approx(expected, rel=1e-9)
+        assert e["t10"] > default[e["id"]]["t10"]

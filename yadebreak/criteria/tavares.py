@@ -16,7 +16,8 @@ from yadebreak.model.materials import GLOBAL_DAMPING_KEY, in_file_unit, read_num
 @register
 class Tavares(Criterion):
     """The Tavares UFRJ criterion of one material. kappa_successive: Eq. 8's kappa for fragments
-    (generation >= 1); None: the material's for every event."""
+    (generation >= 1); None: the material's for every event. t10_energy: the fracture energy in a
+    breakage's t10', "particle" (the body's own, Eq. 8) or "e50b" (Eq. 7 over E50b)."""
 
     name = "tavares"
     keys = (
@@ -43,9 +44,10 @@ class Tavares(Criterion):
     #: read plus 0.2 us per body
     judged_one_by_one = 24
 
-    def __init__(self, material, kappa_successive=None):
+    def __init__(self, material, kappa_successive=None, t10_energy="particle"):
         super().__init__(material)
         self.kappa_successive = kappa_successive
+        self.t10_energy = t10_energy
 
     @staticmethod
     def parse_more(breakage, values, problems):
@@ -55,8 +57,8 @@ class Tavares(Criterion):
                           default=model.DEVICE_STIFFNESS_STEEL / 1e9)
         values["device_stiffness"] = None if dev is None else dev * 1e9
 
-    def with_successive_kappa(self, kappa_successive):
-        return Tavares(self.material, kappa_successive)
+    def with_settings(self, kappa_successive=None, t10_energy="particle"):
+        return Tavares(self.material, kappa_successive, t10_energy)
 
     # -- model side -----------------------------------------------------------------------------
     def median_fracture_energy(self, size):
@@ -153,9 +155,14 @@ class Tavares(Criterion):
         return {"fracture_energy": before, "fracture_energy_after": after, "ratio": ratio}
 
     def breakage(self, table, i, ek):
-        """Eq. 8 at ratio = Ek' / (m E), with kappa_successive for fragments when it is set."""
+        """(ratio = Ek' / (m E), t10', {}): Eq. 8 at that ratio, with kappa_successive for
+        fragments when it is set; t10_energy "e50b": Eq. 7 at Ek'/m over E50b of the body's
+        size (Rocky's Eqs. 2-47 and 2-48)."""
         c = table.columns
-        ratio = ek / (float(c["mass"][i]) * float(c["fracture_energy"][i]))
+        mass = float(c["mass"][i])
+        ratio = ek / (mass * float(c["fracture_energy"][i]))
+        if self.t10_energy == "e50b":
+            return ratio, float(self.t10_once(ek / mass, 2.0 * float(c["radius"][i]))), {}
         kappa = (None if self.kappa_successive is None or c["generation"][i] == 0
                  else self.kappa_successive)
         return ratio, float(self.t10(ratio, kappa)), {}

@@ -64,7 +64,8 @@ class Controller:
         self.material = scene_materials.by_label         # YADE label -> Material
         self.label_by_id = scene_materials.label_by_id
         self.criteria = {lab: criterion_for(mat, config.criteria.breakage,
-                                            config.criteria.kappa_successive)
+                                            config.criteria.kappa_successive,
+                                            config.criteria.t10_energy)
                          for lab, mat in self.material.items()}
         labels = list(self.material)
         self.state = state or EngineState(labels, config.seed, config.output.event_log)

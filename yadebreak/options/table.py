@@ -138,6 +138,12 @@ OPTIONS = (
          "stressing event stops rising, t10' from the event's largest energy (unbreakable "
          "fragments likewise record the t10' of the event's peak)",
          words=("threshold", "peak")),
+    _row("t10_energy", "criteria", "particle", "choice", "-",
+         "the fracture energy in a breakage's t10' (Rocky's 'Energy for t10 Calculation'; "
+         "Tavares materials): 'particle', the body's own (Eq. 8; Rocky's default, 'Current "
+         "Particle Energy'); 'e50b', the median fracture energy of the particles of its size "
+         "that break at the specific energy it absorbed (Eq. 7 with that E50b; Rocky's 'Median "
+         "Specific Fracture Energy (e50b)')", words=("particle", "e50b")),
     _row("emax_ratio", "criteria", None, "number", "-", "overrides the material's Emax/E50 "
          "(Eq. 2)", 1, lo_open=True, none="keeps the file's", token=0.0),
     _row("pause_steps", "criteria", None, "count", "steps", "steps after its creation during "
@@ -206,6 +212,7 @@ class Criteria:
     kappa: float | None
     kappa_successive: float | None
     break_at: str
+    t10_energy: str
     emax_ratio: float | None
     pause_steps: int | None
     breakage: bool

@@ -267,6 +267,8 @@ def settings_text(options, material_names, size, particles, seed, extra="", damp
                if options.get("kappa_successive") else "")
             + ("; beyond the paper: breakage at the stressing event's peak (t10' of its "
                "largest energy)" if options.get("break_at") == "peak" else "")
+            + ("; beyond the paper: t10' over E50b of the energy absorbed at the break "
+               "(Rocky's e50b option)" if options.get("t10_energy") == "e50b" else "")
             + (f"; beyond the paper: dummy spheres {options['dummy_stiffness']:g} times as stiff"
                if options.get("dummy_stiffness", OPTION["dummy_stiffness"].default)
                != OPTION["dummy_stiffness"].default else "")
