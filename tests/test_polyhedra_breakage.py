@@ -1,6 +1,8 @@
 """Breakage of convex polyhedra (YADE Polyhedra): tracked at attach by their sieve size, broken
 into the Laguerre cells of model.cells, the finest to the fines ledger. Conservation is checked
 on the bodies YADE holds after the breakage against the parent just before it."""
+from typing import NamedTuple
+
 import numpy as np
 import pytest
 from scipy.optimize import linprog
@@ -82,71 +84,114 @@ def test_polyhedron_tracked_at_attach_by_its_sieve_size(scene):
     assert row.fracture_energy == pytest.approx(float(energies[0]), rel=1e-12)
 
 
-def test_breakage_of_a_spinning_polyhedron_conserves_everything(scene):
+class Before(NamedTuple):
+    """A parent just before its breakage: its pose, mass, volume, momenta and energy."""
+    mass: float
+    volume: float
+    origin: np.ndarray          # centroid (m)
+    rotation: np.ndarray        # body frame to world
+    local: np.ndarray           # vertices in the body frame (m)
+    spin_local: np.ndarray      # angular velocity in the body frame (rad/s)
+    hull: np.ndarray            # world vertices (m)
+    rigid: tuple                # _rigid: momentum, angular momentum, kinetic energy
+
+
+def _before(body):
+    s = body.state
+    hull = _world_vertices(body)
+    return Before(s.mass, convex_polyhedron(hull).volume, np.array(s.pos),
+                  np.array(s.ori.toRotationMatrix()), np.array([tuple(v) for v in body.shape.v]),
+                  np.array(s.ori.conjugate() * s.angVel), hull, _rigid(body, np.array(s.pos)))
+
+
+def _break_and_check(brk, bid, ratio, generation):
+    """Break body `bid` and check conservation, tracking and geometry; returns the event."""
     from yade import O
-    brk, bid = _free_polyhedron()
     parent = O.bodies[bid]
-    mass, origin = parent.state.mass, np.array(parent.state.pos)
     density = parent.material.density
-    volume = convex_polyhedron(_world_vertices(parent)).volume
-    p0, l0, k0 = _rigid(parent, origin)
-    local = np.array([tuple(v) for v in parent.shape.v])
-    spin_local = np.array(parent.state.ori.conjugate() * parent.state.angVel)
-    rot = np.array(parent.state.ori.toRotationMatrix())
+    was = _before(parent)
     twin = np.random.default_rng()
     twin.bit_generator.state = brk.state.rng.bit_generator.state
-    event = brk.break_body(bid, ratio=5.0)
+    ledger_before = len(brk.ledger)
+    event = brk.break_body(bid, ratio=ratio)
     frags = event["fragments"]
     # the same draws give the same cells: the ledger's cells are known
-    size = 2.0 * event["radius"]
-    frag = fragment_cells(twin, local, event["t10"], load_material("copper_ore").beta_params,
-                          model.X_MIN * size)
-    assert O.bodies[bid] is None and len(frags) == len(frag.volumes) >= 4
+    frag = fragment_cells(twin, was.local, event["t10"], load_material("copper_ore").beta_params,
+                          model.X_MIN * 2.0 * event["radius"])
+    assert O.bodies[bid] is None and len(frags) == len(frag.volumes) >= 2
     bodies = [O.bodies[i] for i in frags]
-    ledger = brk.ledger.entries
+    ledger = brk.ledger.entries[ledger_before:]
     assert len(ledger) == len(frag.ledger_volumes)
+    assert all(e["parent_size"] == 2.0 * event["radius"] and e["t10"] == event["t10"]
+               for e in ledger)
     # mass and volume
     m_ledger = sum(e["mass"] for e in ledger)
-    assert sum(b.state.mass for b in bodies) + m_ledger == pytest.approx(mass, rel=1e-13)
+    assert sum(b.state.mass for b in bodies) + m_ledger == pytest.approx(was.mass, rel=1e-13)
     v_cells = sum(convex_polyhedron(_world_vertices(b)).volume for b in bodies)
-    assert v_cells + m_ledger / density == pytest.approx(volume, rel=1e-12)
-    assert brk.total_mass() == pytest.approx(mass, rel=1e-13)
+    assert v_cells + m_ledger / density == pytest.approx(was.volume, rel=1e-12)
     # momentum, angular momentum, kinetic energy (ledger cells: translation in their momenta,
-    # spin 0.5 w.I w from their own geometry, turned to the world frame)
-    sums = [_rigid(b, origin) for b in bodies]
+    # spin from their own geometry)
+    p0, l0, k0 = was.rigid
+    sums = [_rigid(b, was.origin) for b in bodies]
     p1 = sum(s[0] for s in sums) + sum(np.array(e["momentum"]) for e in ledger)
     np.testing.assert_allclose(p1, p0, rtol=0, atol=1e-12 * np.linalg.norm(p0))
-    l_ledger, k_ledger_spin = _ledger_spin(frag, ledger, rot, spin_local, mass / frag.parent_volume)
-    k1 = sum(s[2] for s in sums) + brk.ledger.kinetic_energy() + k_ledger_spin
-    assert k1 == pytest.approx(k0, rel=1e-12)
-    assert event["kinetic_energy_after"] == pytest.approx(k0, rel=1e-12)
+    l_ledger, k_spin = _ledger_spin(frag, ledger, was, was.mass / frag.parent_volume)
     l1 = sum(s[1] for s in sums) + l_ledger
     np.testing.assert_allclose(l1, l0, rtol=0, atol=1e-12 * np.linalg.norm(l0))
+    k_ledger = sum(0.5 * np.dot(e["momentum"], e["momentum"]) / e["mass"] for e in ledger)
+    assert sum(s[2] for s in sums) + k_ledger + k_spin == pytest.approx(k0, rel=1e-12)
     assert event["kinetic_energy_before"] == pytest.approx(k0, rel=1e-12)
-    # fragments: tracked, one generation on, disjoint, inside the parent
+    assert event["kinetic_energy_after"] == pytest.approx(k0, rel=1e-12)
+    # fragments: tracked, one generation on
     rows = [brk.bodies[i] for i in frags]
     assert all(i in brk.state.tracked for i in frags)
-    assert {r.generation for r in rows} == {1}
-    assert {r.kind for r in rows} <= {"breakable", "unbreakable"} and rows[0].kind == "breakable"
+    assert {r.generation for r in rows} == {generation}
+    assert {r.kind for r in rows} <= {"breakable", "unbreakable"}
+    _check_geometry(bodies, rows, was.hull)
+    return event
+
+
+def _check_geometry(bodies, rows, parent):
+    """Each cell inside the parent, sized by its sieve size, its interior disjoint from every
+    other's (its centroid outside every other cell; no point deeper than 1e-9 of the parent's
+    size inside two cells)."""
+    outer = ConvexHull(parent).equations
+    scale = float(np.ptp(parent, axis=0).max())
     hulls = [_world_vertices(b) for b in bodies]
     for r, v in zip(rows, hulls):
         assert 2.0 * r.radius == pytest.approx(sieve_size(v), rel=1e-9)
+        assert np.max(v @ outer[:, :3].T + outer[:, 3]) < 1e-12 * scale
     for i, a in enumerate(hulls):
         inside = ConvexHull(a).equations
         for j, b in enumerate(hulls):
             if i == j:
                 continue
             c = convex_polyhedron(b).centroid
-            assert np.max(inside[:, :3] @ c + inside[:, 3]) > 0.0     # outside cell i
+            assert np.max(inside[:, :3] @ c + inside[:, 3]) > 0.0
             if j > i:
-                assert _interiors_meet(a, b, SIZE) < 1e-9 * SIZE
-    return brk, frags
+                assert _interiors_meet(a, b, scale) < 1e-9 * scale
 
 
-def _ledger_spin(frag, ledger, rot, spin_local, density):
+def test_breakage_of_a_spinning_polyhedron_conserves_everything(scene):
+    from yade import O
+    brk, bid = _free_polyhedron()
+    mass = O.bodies[bid].state.mass
+    first = _break_and_check(brk, bid, 5.0, generation=1)
+    assert len(first["fragments"]) >= 4
+    assert brk.total_mass() == pytest.approx(mass, rel=1e-13)
+    # the largest fragment breaks again, spinning and moving with the parent's field
+    largest = max(first["fragments"], key=lambda i: brk.bodies[i].mass)
+    assert brk.bodies[largest].kind == "breakable"
+    second = _break_and_check(brk, largest, 5.0, generation=2)
+    assert second["generation"] == 1
+    assert brk.total_mass() == pytest.approx(mass, rel=1e-13)
+
+
+def _ledger_spin(frag, ledger, was, density):
     """Angular momentum about the parent's centroid (world frame) and spin energy 0.5 w.I w of
-    the ledger's cells: their inertia from their vertices in the parent's body frame (rotation
-    `rot` to the world), their density the parent's mass over its volume."""
+    the ledger's cells: their inertia from their vertices in the parent's body frame, their
+    density the parent's mass over its volume."""
+    rot, spin_local = was.rotation, was.spin_local
     momentum, energy = np.zeros(3), 0.0
     for verts, centroid, entry in zip(frag.ledger_vertices, frag.ledger_centroids, ledger):
         inertia = convex_polyhedron(verts).inertia * density
