@@ -199,3 +199,22 @@ def _ledger_spin(frag, ledger, was, density):
         momentum += rot @ (inertia @ spin_local)
         energy += 0.5 * spin_local @ inertia @ spin_local
     return momentum, energy
+
+
+def test_small_polyhedron_gets_its_principal_inertia(scene):
+    """A 3 mm body: YADE alone would skip its turn to principal axes (off-diagonal products of
+    inertia below its absolute 1e-13 m^5) and take the diagonal as the principal moments."""
+    from yade import O
+    from yadebreak.scenes import polyhedra
+    polyhedra.polyhedra_materials({"ore": "copper_ore"})
+    vertices = polyhedra.random_convex_vertices(0.003, np.random.default_rng(0))
+    body = O.bodies[O.bodies.append(polyhedra.polyhedron(vertices, "ore", (0.1, 0.2, 0.3)))]
+    exact = convex_polyhedron(vertices)
+    moments = np.linalg.eigvalsh(exact.inertia) * body.material.density
+    np.testing.assert_allclose(np.sort(np.array(body.state.inertia)), moments, rtol=1e-12)
+    world = _world_vertices(body)
+    np.testing.assert_allclose(convex_polyhedron(world).centroid, (0.1, 0.2, 0.3), rtol=1e-14)
+    # the same body where it was given (its vertices, moved to the position), turned nowhere
+    given = vertices - exact.centroid + np.array([0.1, 0.2, 0.3])
+    gap = np.linalg.norm(world[:, None, :] - given[None, :, :], axis=2).min(axis=1)
+    assert gap.max() < 1e-15 * 0.3 * 10

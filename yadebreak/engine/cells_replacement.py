@@ -81,6 +81,11 @@ def cells_kinetic_energy(cells, spin):
     return 0.5 * (translation + rotation)
 
 
+#: YADE's Polyhedra turns a shape to its principal axes only when the off-diagonal products of
+#: inertia per unit density (m^5) sum to more than this (pkg/dem/Polyhedra.cpp, Initialize)
+YADE_TURN_THRESHOLD = 1e-13
+
+
 def principal_axes(vertices):
     """The principal axes (columns, a right-handed rotation) of the hull of `vertices`."""
     _, _, inertia = polyhedron_mass_properties(vertices)
@@ -90,11 +95,22 @@ def principal_axes(vertices):
     return axes
 
 
+def skipped_turn(vertices):
+    """The principal axes of the hull of `vertices` (centred on its centroid) where YADE would
+    not turn the shape to them though its inertia is not diagonal (YADE_TURN_THRESHOLD); None
+    where YADE's own turn is right."""
+    _, _, inertia = polyhedron_mass_properties(vertices)
+    off = abs(inertia[0, 1]) + abs(inertia[0, 2]) + abs(inertia[1, 2])
+    if off >= YADE_TURN_THRESHOLD or off <= 1e-12 * np.trace(inertia):
+        return None
+    return principal_axes(vertices)
+
+
 def cell_body(material, vertices, centroid, mass, velocity, spin, damped):
     """A Polyhedra body of `vertices` (relative to its centroid, world frame) at `centroid`, its
     inertia scaled to `mass`. The shape is given to YADE in its principal axes: YADE turns a
     shape to them only when the off-diagonal products of inertia per unit density sum to more
-    than 1e-13 m^5 (an absolute threshold), and takes the diagonal as the principal moments
+    than YADE_TURN_THRESHOLD (an absolute one), and takes the diagonal as the principal moments
     otherwise, 15-35 % off for the cells of a 20 mm parent (measured). Aspherical bodies are
     integrated from their angular momentum: it is set from `spin`."""
     axes = principal_axes(vertices)
