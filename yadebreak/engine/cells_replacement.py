@@ -170,7 +170,6 @@ class CellBreakage:
         radii = 0.5 * cells.sieve_sizes[keep]
         rep.new_rows(ids, label, np.zeros(len(ids), bool), radii, cells.masses[keep], t10,
                      parent_size, int(table.columns["generation"][bid]) + 1, dmin)
-        rep.zeroing.wake()
         reach = np.linalg.norm(local, axis=1).max()
         speed = np.linalg.norm(cells.velocities[keep], axis=1).max() if ids else 0.0
         excess = float(speed - np.linalg.norm(pose.velocity) - np.linalg.norm(pose.spin) * reach)
