@@ -142,9 +142,10 @@ class CellBreakage:
     def replace(self, bid, t10, dmin, elastic_before):
         """Erase polyhedron `bid` and insert its cells for t10' (%). `elastic_before`: the
         energy (J) its contacts held. Returns the fields of replacement.Progeny: fragment ids,
-        t10', speed excess, smallest, audit. The cells' contacts are left to the collider: they
-        touch face to face, and Ig2_Polyhedra_Polyhedra_ScGeom takes the overlap at first touch
-        as its zero, so no contact of a fresh cell holds energy (elastic_energy_after 0)."""
+        t10', speed excess, smallest, audit. No contact is made here (elastic_energy_after 0):
+        the collider finds the cells' contacts. They touch face to face: on the volumetric law
+        a shared face makes no force; through Ig2_Polyhedra_Polyhedra_ScGeom they start with
+        an overlap and fly apart (docs/polyhedra.md)."""
         rep = self.replacer
         table, body = rep.table, O.bodies[bid]
         label = table.label_of(bid)
