@@ -73,7 +73,7 @@ def test_non_sphere_with_breakable_material(scene):
     from yade import O, utils
     engine = _scene()
     O.bodies.append(utils.box((0.1, 0, 0.01), (0.005, 0.005, 0.005), material="ore"))
-    with pytest.raises(engine.AttachError, match="Box.*only spheres can break"):
+    with pytest.raises(engine.AttachError, match="Box.*only spheres and polyhedra can break"):
         engine.attach({"ore": "copper_ore"})
 
 

@@ -5,9 +5,9 @@ from yadebreak.adapter.yadepath import ensure_yade_importable
 ensure_yade_importable()
 
 import yade.wrapper as wrapper  # noqa: E402
-from yade import O, Vector3, geom, utils  # noqa: E402
+from yade import Matrix3, O, Quaternion, Vector3, geom, utils  # noqa: E402
 
-__all__ = ["O", "Vector3", "close_remote_access", "current_scene", "extend_match_makers",
+__all__ = ["Matrix3", "O", "Quaternion", "Vector3", "close_remote_access", "current_scene", "extend_match_makers",
            "find_engine", "geom", "scene_folder", "table_row", "utils", "wrapper"]
 
 

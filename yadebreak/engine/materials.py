@@ -8,6 +8,7 @@ from collections.abc import Mapping
 
 from yadebreak import model
 from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS
+from yadebreak.model.cells import sieve_size
 from yadebreak.model.materials import Material, MaterialError, load_material
 from yadebreak.adapter.yade_api import O, extend_match_makers, wrapper
 from yadebreak.options.table import AttachError
@@ -206,19 +207,27 @@ def resolve(materials, kappa=None, emax_ratio=None):
 
 def breakable_spheres(label_by_id):
     """state.Breakable records of the scene's bodies with a breakable material (attach only:
-    a pass over every body); anything but a loose sphere with such a material is an error."""
+    a pass over every body): loose spheres, and convex polyhedra (YADE Polyhedra), whose
+    `radius` is half their sieve size (model.cells.sieve_size: 2 radius is the size of Eq. 3 and
+    of the t10 sieves, as a sphere's diameter is). Anything else with such a material is an
+    error."""
     found, problems = [], []
     for b in O.bodies:
         label = label_by_id.get(b.material.id if b is not None and b.material is not None
                                 else None)
         if label is None:
             continue
-        if not isinstance(b.shape, wrapper.Sphere):
+        polyhedron = isinstance(b.shape, wrapper.Polyhedra)
+        if not (polyhedron or isinstance(b.shape, wrapper.Sphere)):
             problems.append(f"body {b.id} ({type(b.shape).__name__}) has the breakable material "
-                            f"'{label}' but only spheres can break: give it another material")
+                            f"'{label}' but only spheres and polyhedra can break: give it another "
+                            "material")
         elif b.isClumpMember or b.isClump:
             problems.append(f"body {b.id} is part of a clump and has the breakable material "
                             f"'{label}': clumps cannot break; use loose spheres")
+        elif polyhedron:
+            size = sieve_size([tuple(v) for v in b.shape.v])
+            found.append(Breakable(b.id, label, b.state.mass, 0.5 * size))
         else:
             found.append(Breakable(b.id, label, b.state.mass, b.shape.radius))
     if problems:

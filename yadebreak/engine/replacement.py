@@ -12,6 +12,7 @@ import numpy as np
 from yadebreak import model
 from yadebreak.model import placement
 from yadebreak.adapter.yade_api import O, utils, wrapper
+from yadebreak.engine.cells_replacement import CellBreakage
 from yadebreak.engine.state import BREAKABLE, DUMMY, UNBREAKABLE
 
 
@@ -89,7 +90,8 @@ class Recipe:
 
 
 class Replacer:
-    """Replaces broken spheres; one per engine."""
+    """Replaces broken bodies, by the parent's shape: a sphere by a family of spheres, a convex
+    polyhedron by its cells (cells_replacement); one per engine."""
 
     def __init__(self, options, state, recipes, zeroing, reader):
         self.options = options         # config.Replacement
@@ -99,11 +101,20 @@ class Replacer:
         self.recipes = recipes         # material label -> Recipe
         self.zeroing = zeroing
         self.reader = reader           # told which contacts the fragments inherit
+        self.cells = CellBreakage(self)
 
     def replace(self, bid, t10, direction, dmin):
-        """Erase body `bid` and insert its progeny for t10' (%), coarse fragments across
-        `direction` (the normal of its most energetic contact)."""
+        """Erase body `bid` and insert its progeny for t10' (%): a polyhedron's cells, or a
+        sphere's family, coarse fragments across `direction` (the normal of its most energetic
+        contact). Returns a Progeny."""
         body = O.bodies[bid]
+        if isinstance(body.shape, wrapper.Polyhedra):
+            _, elastic = _neighbours(bid, self.zeroing)
+            return Progeny(*self.cells.replace(bid, t10, dmin, elastic))
+        return self._replace_sphere(body, bid, t10, direction, dmin)
+
+    def _replace_sphere(self, body, bid, t10, direction, dmin):
+        """A sphere's family (replace)."""
         label = self.table.label_of(bid)
         radius = float(self.table.columns["radius"][bid])
         mass = float(self.table.columns["mass"][bid])
@@ -142,7 +153,7 @@ class Replacer:
                for k, c, r, m, v in zip(kinds, centers.tolist(), radii.tolist(), masses.tolist(),
                                         vel.tolist())]
         ids = list(O.bodies.append(new))
-        self._new_rows(ids, label, fam.is_dummy[keep], radii, masses, t10, 2.0 * radius,
+        self.new_rows(ids, label, fam.is_dummy[keep], radii, masses, t10, 2.0 * radius,
                        int(self.table.columns["generation"][bid]) + 1, dmin)
         held, elastic_after = (self._contacts(ids, centers, radii, neighbours) if ids
                                else (np.zeros(0), 0.0))
@@ -163,7 +174,7 @@ class Replacer:
                 smallest[k.id] = (r, k)
         return Progeny(ids, fam.t10, speed_excess, list(smallest.values()), audit)
 
-    def _new_rows(self, ids, label, is_dummy, radii, masses, t10, parent_size, generation, dmin):
+    def new_rows(self, ids, label, is_dummy, radii, masses, t10, parent_size, generation, dmin):
         """The fragments' state: dummy, unbreakable (its own progeny would be finer than dmin)
         or breakable, with fracture energies drawn at their own sizes (unbreakable ones too:
         their first would-be breakage gives the t10' they keep)."""

@@ -91,7 +91,8 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
 
     materials: {YADE material label: material name, path or Material}; bodies of other materials
     are non-breakable partners. Call after O.engines is set (an InteractionLoop with
-    Law2_ScGeom_MindlinPhys_Mindlin) and the breakable spheres exist. Options: see
+    Law2_ScGeom_MindlinPhys_Mindlin) and the breakable spheres (or convex Polyhedra: see
+    docs/polyhedra.md) exist. Options: see
     config.OPTIONS (docs/options.md), checked before anything changes. Each material file
     chooses its criterion (breakage.model = "tavares" or "ab_t10"); one scene may mix both.
     """

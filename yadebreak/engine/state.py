@@ -21,11 +21,11 @@ FORMAT_VERSION = 2
 
 
 class Breakable(NamedTuple):
-    """A breakable sphere found in the scene at attach."""
+    """A breakable body found in the scene at attach: a sphere or a convex polyhedron."""
     id: int
     label: str            # its YADE material's label
     mass: float           # kg
-    radius: float         # m
+    radius: float         # m: a sphere's; half a polyhedron's sieve size
 
 
 #: column -> (dtype, value of a new row); energies J/kg, event_max J, sizes m, mass kg

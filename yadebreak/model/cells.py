@@ -77,8 +77,15 @@ def polyhedron_mass_properties(vertices):
     return float(volume), apex + centre, inertia
 
 
+#: Boxes whose volumes differ by less than this (relative) are equally small: round-off, which
+#: the body's orientation changes, must not choose among them (a cell can have two boxes of one
+#: volume and different breadths); the one of least breadth is taken.
+_BOX_TIE = 1e-9
+
+
 def _flush_box_extents(points, hull):
-    """Sorted extents (largest first) of the smallest-volume box with a face flush on a hull face.
+    """Sorted extents (largest first) of the smallest-volume box with a face flush on a hull face
+    (of equally small ones, _BOX_TIE, the one of least intermediate extent).
 
     For every distinct face normal n, the box's other axes follow the directions of the hull's
     edges projected on the plane normal to n (a rectangle of least area around a convex polygon
@@ -98,11 +105,14 @@ def _flush_box_extents(points, hull):
         a1 = e1[n_idx, k_idx] / length[n_idx, k_idx, None]
         a3 = chunk[n_idx]
         a2 = np.cross(a3, a1)
-        ext = np.stack([np.ptp(pts @ a.T, axis=0) for a in (a1, a2, a3)], axis=1)
-        i = np.argmin(ext.prod(axis=1))
-        if best is None or ext[i].prod() < best.prod():
-            best = ext[i]
-    return np.sort(best)[::-1]
+        ext = np.sort(np.stack([np.ptp(pts @ a.T, axis=0) for a in (a1, a2, a3)], axis=1),
+                      axis=1)[:, ::-1]
+        volume = ext.prod(axis=1)
+        near = ext[volume <= volume.min() * (1.0 + _BOX_TIE)]
+        best = near if best is None else np.vstack([best, near])
+    volume = best.prod(axis=1)
+    near = best[volume <= volume.min() * (1.0 + _BOX_TIE)]
+    return near[np.argmin(near[:, 1])]
 
 
 def sieve_size(vertices):

@@ -18,8 +18,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from yadebreak.adapter.yade_api import O, Vector3, utils, wrapper as _w
+from yadebreak.adapter.yade_api import Matrix3, O, Quaternion, Vector3, utils, wrapper as _w
 from yadebreak.engine import add_materials
+from yadebreak.engine.cells_replacement import skipped_turn
 from yadebreak import model
 from yadebreak.model import placement
 from yadebreak.model.cells import convex_polyhedron
@@ -62,15 +63,24 @@ def polyhedron(vertices, material, position=(0.0, 0.0, 0.0), velocity=(0.0, 0.0,
     """A body of the convex hull of `vertices` (n x 3, m; any frame) with YADE material label
     `material`, its centroid at `position`. YADE re-centres the shape on its centroid, turns it
     to its principal axes and gives its volume and inertia exactly; mass and inertia are those
-    times the density. `fixed`: every degree of freedom blocked (a plate). Not appended."""
+    times the density. `fixed`: every degree of freedom blocked (a plate). Not appended.
+    A small body, whose turn to its principal axes YADE skips (cells_replacement.skipped_turn),
+    is given to YADE in them."""
     mat = _material(material)
+    pts = np.asarray(vertices, dtype=float)
+    centred = pts - convex_polyhedron(pts).centroid
+    axes = skipped_turn(centred)
+    if axes is not None:
+        pts = centred @ axes
     body = _w.Body()
     body.aspherical = True
-    body.shape = _w.Polyhedra(v=[Vector3(*map(float, v)) for v in np.asarray(vertices)])
+    body.shape = _w.Polyhedra(v=[Vector3(*map(float, v)) for v in pts])
     body.material = mat
     body.state.mass = mat.density * body.shape.GetVolume()
     body.state.inertia = body.shape.GetInertia() * mat.density
     body.state.ori = body.shape.GetOri()
+    if axes is not None:
+        body.state.ori = Quaternion(Matrix3(*axes.ravel().tolist())) * body.state.ori
     body.state.pos = Vector3(*map(float, position))
     body.state.vel = Vector3(*map(float, velocity))
     if fixed:
