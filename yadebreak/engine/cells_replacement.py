@@ -139,9 +139,10 @@ class CellBreakage:
     def __init__(self, replacer):
         self.replacer = replacer
 
-    def replace(self, bid, t10, dmin, elastic_before):
+    def replace(self, bid, t10, dmin, elastic_before, neighbours=()):
         """Erase polyhedron `bid` and insert its cells for t10' (%). `elastic_before`: the
-        energy (J) its contacts held. Returns the fields of replacement.Progeny: fragment ids,
+        energy (J) its contacts held; `neighbours`: the ids it touched, whose contacts with the
+        cells count work from the state they start in (the reader's inherit). Returns the fields of replacement.Progeny: fragment ids,
         t10', speed excess, smallest, audit. No contact is made here (elastic_energy_after 0):
         the collider finds the cells' contacts. They touch face to face: on the volumetric law
         a shared face makes no force; through Ig2_Polyhedra_Polyhedra_ScGeom they start with
@@ -168,6 +169,7 @@ class CellBreakage:
         new = [cell_body(material, cells.vertices[k], cells.centroids[k], cells.masses[k],
                          cells.velocities[k], pose.spin, recipe.damped) for k in keep]
         ids = list(O.bodies.append(new)) if new else []
+        rep.reader.inherit([(i, n) for i in ids for n in neighbours])
         radii = 0.5 * cells.sieve_sizes[keep]
         rep.new_rows(ids, label, np.zeros(len(ids), bool), radii, cells.masses[keep], t10,
                      parent_size, int(table.columns["generation"][bid]) + 1, dmin)

@@ -75,13 +75,15 @@ class Controller:
                                   is not None else crit.default_pause_steps)
                             for lab, crit in self.criteria.items()}
         self.reader = ContactReader(scene_materials.stiffness_by_id, config.reading.cs,
-                                    config.reading.emin)
+                                    config.reading.emin, scene_materials.law)
         self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero",
                                       config.replacement.zeroing_tolerance)
-        fast = config.reading.read_period == "fast"
+        volumetric = scene_materials.law == "volumetric"
+        fast = config.reading.read_period == "fast" and not volumetric
         self.tracking = Tracking(self.state, config.reading.fast_tolerance if fast else None)
         self.schedule = ReadSchedule(config.reading, label, self.tracking.smallest_breakable,
-                                     self.tracking.reach_now if fast else None)
+                                     self.tracking.reach_now if fast else None,
+                                     every_step=volumetric)
         self.time_step = TimeStep(config.time_step.time_step_fraction, self._warn_once)
         gd = config.time_step.global_damping        # None: each material file's
         self.damping = FragmentDamping(

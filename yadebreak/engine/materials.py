@@ -7,7 +7,7 @@ import math
 from collections.abc import Mapping
 
 from yadebreak import model
-from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS
+from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS, Interval
 from yadebreak.model.cells import sieve_size
 from yadebreak.model.materials import Material, MaterialError, load_material
 from yadebreak.adapter.yade_api import O, extend_match_makers, wrapper
@@ -29,11 +29,11 @@ _PHYSICAL = (("young", YOUNG_MODULUS, "Pa"), ("poisson", POISSON_RATIO, "-"),
              ("density", DENSITY, "kg/m3"))
 
 
-def check_physical(mat, what):
+def check_physical(mat, what, fields=_PHYSICAL):
     """Raise AttachError, one line, if YADE material `mat` (any with these attributes) has a
     Young's modulus, Poisson's ratio or density outside its physical range (intervals.py);
     `what` names it. Checked before a run: such values overflow the time step midway."""
-    for field, interval, unit in _PHYSICAL:
+    for field, interval, unit in fields:
         value = getattr(mat, field, None)
         if value is not None and float(value) not in interval:
             shown = "" if unit == "-" else f" {unit}"
@@ -158,8 +158,11 @@ class SceneMaterials:
 
     by_label: dict          # YADE label -> Material (breakable)
     label_by_id: dict       # YADE material id -> label, for breakable materials
-    stiffness_by_id: dict   # YADE material id -> Hertz stiffness Y / (1 - nu^2) (Pa; inf if rigid)
+    stiffness_by_id: dict   # YADE material id -> the stiffness of Eq. 4's shares: Hertz's
+    #                         Y / (1 - nu^2) (Pa; inf if rigid), or on the volumetric law kn
+    #                         (N/m3: PolyhedraMat.young)
     dummy_by_label: dict    # breakable label -> YADE material of its softer dummies (if made)
+    law: str = "hertz_mindlin"   # the contact law the engine reads (contacts.reader.LAWS)
 
 
 def check_mapping(materials):
@@ -186,23 +189,31 @@ def check_mapping(materials):
     return found
 
 
-def resolve(materials, kappa=None, emax_ratio=None):
+#: on YADE's volumetric law a PolyhedraMat's `young` is its kn (N/m3), not a Young's modulus
+_VOLUMETRIC = (("young", Interval(0.0, math.inf, lo_open=True, hi_open=True), "N/m3"),
+               *_PHYSICAL[1:])
+
+
+def resolve(materials, kappa=None, emax_ratio=None, law="hertz_mindlin"):
     """Map the checked {label: Material} (check_mapping) onto the scene's labelled YADE
-    materials, with the options that override the files (Tavares materials only)."""
+    materials, with the options that override the files (Tavares materials only). `law`: the
+    contact law the engine reads (scene.contact_law)."""
     by_label = {lab: criterion_for(mat).overridden(kappa=kappa, emax_ratio=emax_ratio)
                 for lab, mat in materials.items()}
     stiffness, label_by_id = {}, {}
+    volumetric = law == "volumetric"
     for m in O.materials:
-        check_physical(m, f"YADE material {m.label or m.id!r}")
+        kn = volumetric and isinstance(m, wrapper.PolyhedraMat)
+        check_physical(m, f"YADE material {m.label or m.id!r}", _VOLUMETRIC if kn else _PHYSICAL)
         young = getattr(m, "young", None)
-        stiffness[m.id] = (math.inf if young is None
+        stiffness[m.id] = (math.inf if young is None else float(young) if kn
                            else float(model.hertz_stiffness(young, getattr(m, "poisson", 0.0))))
         if m.label in by_label:
             label_by_id[m.id] = m.label
     cut = len(DUMMY_SUFFIX)
     dummies = {m.label[:-cut]: m for m in O.materials
                if m.label.endswith(DUMMY_SUFFIX) and m.label[:-cut] in by_label}
-    return SceneMaterials(by_label, label_by_id, stiffness, dummies)
+    return SceneMaterials(by_label, label_by_id, stiffness, dummies, law)
 
 
 def breakable_spheres(label_by_id):

@@ -46,8 +46,12 @@ def _elastic_energy(inter, zeroed):
     return energy
 
 
-def _neighbours(bid, zeroing):
-    """The parent's neighbours (ids) and the elastic energy (J) of its contacts with them."""
+def _neighbours(bid, zeroing, reader=None):
+    """The parent's neighbours (ids) and the elastic energy (J) of its contacts with them (on
+    the volumetric law, what the reader's rows hold)."""
+    if reader is not None and reader.volumetric:
+        found = [i.id2 if i.id1 == bid else i.id1 for i in O.interactions.withBody(bid)]
+        return found, reader.held(bid)
     found, energy = [], 0.0
     for inter in O.interactions.withBody(bid):
         other = inter.id2 if inter.id1 == bid else inter.id1
@@ -109,8 +113,8 @@ class Replacer:
         contact). Returns a Progeny."""
         body = O.bodies[bid]
         if isinstance(body.shape, wrapper.Polyhedra):
-            _, elastic = _neighbours(bid, self.zeroing)
-            return Progeny(*self.cells.replace(bid, t10, dmin, elastic))
+            neighbours, elastic = _neighbours(bid, self.zeroing, self.reader)
+            return Progeny(*self.cells.replace(bid, t10, dmin, elastic, neighbours))
         return self._replace_sphere(body, bid, t10, direction, dmin)
 
     def _replace_sphere(self, body, bid, t10, direction, dmin):

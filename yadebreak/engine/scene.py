@@ -103,21 +103,17 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
         raise AttachError(f"yadebreak is already attached to this scene as '{label}': call attach "
                           "once per scene (or give another label)")
     engines = list(O.engines)
-    loop_idx = next((k for k, e in enumerate(engines) if isinstance(e, wrapper.InteractionLoop)),
-                    None)
-    if loop_idx is None:
-        raise AttachError("O.engines has no InteractionLoop: set O.engines (with "
-                          "Law2_ScGeom_MindlinPhys_Mindlin) before calling yadebreak.attach")
-    laws = engines[loop_idx].lawDispatcher.functors
-    if not any(isinstance(f, wrapper.Law2_ScGeom_MindlinPhys_Mindlin) for f in laws):
-        raise AttachError("the InteractionLoop has no Law2_ScGeom_MindlinPhys_Mindlin: yadebreak "
-                          "reads YADE's Hertz-Mindlin forces (use add_materials() for the Ip2)")
+    loop_idx, law = contact_law(engines)
+    if law == "volumetric" and config.reading.cs > 0.0:
+        raise AttachError(f"cs = {config.reading.cs:g}: the volumetric law's shear work is not "
+                          "read; accepted 0 with polyhedra on Law2_PolyhedraGeom_PolyhedraPhys_"
+                          "Volumetric")
     label_ids = {m.id: m.label for m in O.materials if m.label in materials}
     spheres = breakable_spheres(label_ids)
     _check_not_tracked_elsewhere(label, [s[0] for s in spheres])
     # every check is done: from here on the scene changes
     dummy_materials(materials, config.replacement.dummy_stiffness, engines[loop_idx])
-    scene_materials = resolve(found, config.criteria.kappa, config.criteria.emax_ratio)
+    scene_materials = resolve(found, config.criteria.kappa, config.criteria.emax_ratio, law)
     ctl = Controller(label, config, scene_materials, materials)
     ctl.register(spheres)
     if not len(ctl.bodies):
@@ -132,6 +128,33 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     protocol.install(Zeroing(label + "_zero"), engines, awake=False)
     O.engines = engines
     return ctl
+
+
+#: YADE's laws whose contacts the engine reads, and the reader's name of each
+READ_LAWS = (("Law2_ScGeom_MindlinPhys_Mindlin", "hertz_mindlin"),
+             ("Law2_PolyhedraGeom_PolyhedraPhys_Volumetric", "volumetric"))
+
+
+def contact_law(engines):
+    """(index of the InteractionLoop in `engines`, the law the engine reads there): Hertz-Mindlin
+    (spheres, and polyhedra through ScGeom) or the volumetric law of polyhedra, one per scene
+    (docs/polyhedra.md: the two cannot meet in one scene)."""
+    loop_idx = next((k for k, e in enumerate(engines) if isinstance(e, wrapper.InteractionLoop)),
+                    None)
+    if loop_idx is None:
+        raise AttachError("O.engines has no InteractionLoop: set O.engines (with "
+                          "Law2_ScGeom_MindlinPhys_Mindlin) before calling yadebreak.attach")
+    names = {type(f).__name__ for f in engines[loop_idx].lawDispatcher.functors}
+    found = [ours for theirs, ours in READ_LAWS if theirs in names]
+    if not found:
+        raise AttachError("the InteractionLoop has no Law2_ScGeom_MindlinPhys_Mindlin: yadebreak "
+                          "reads YADE's Hertz-Mindlin forces (use add_materials() for the Ip2), or "
+                          "for polyhedra Law2_PolyhedraGeom_PolyhedraPhys_Volumetric")
+    if len(found) > 1:
+        raise AttachError("the InteractionLoop has both Law2_ScGeom_MindlinPhys_Mindlin and "
+                          "Law2_PolyhedraGeom_PolyhedraPhys_Volumetric: yadebreak reads one "
+                          "contact law per scene")
+    return loop_idx, found[0]
 
 
 def _check_event_log(path):
@@ -230,7 +253,7 @@ def _restore(label, data, period):
             f"yadebreak.save(path)")
     config = Config.from_options(**{**data["options"], "event_log": _stored_event_log(data)})
     scene_materials = resolve(check_mapping(data["materials"]), config.criteria.kappa,
-                              config.criteria.emax_ratio)
+                              config.criteria.emax_ratio, contact_law(list(O.engines))[1])
     state = EngineState.from_dict(data["state"], config.output.event_log)
     ctl = Controller(label, config, scene_materials, data["materials"], state)
     own = find_engine(label)                  # a PyRunner of its own (older scenes)

@@ -90,13 +90,15 @@ class Reach:
 class ReadSchedule:
     """How many steps to the next read: a fixed k, "auto" (k dt <= read_fraction of the Rayleigh
     time of the smallest breakable body) or "fast" (as often as the loading requires). The
-    period is the engine part's (protocol.set_period)."""
+    period is the engine part's (protocol.set_period). `every_step`: read every step whatever
+    the option says (polyhedra on the volumetric law: contacts/volumetric.py)."""
 
-    def __init__(self, options, engine_label, smallest, reach=None):
+    def __init__(self, options, engine_label, smallest, reach=None, every_step=False):
         self.options = options                # config.Reading
-        self.mode = options.read_period if options.read_period in ("auto", "fast") else "every"
+        self.mode = ("every" if every_step or options.read_period not in ("auto", "fast")
+                     else options.read_period)
         self.period = (options.read_period if isinstance(options.read_period, int)
-                       and self.mode == "every" else 1)           # "every_step": 1
+                       and not every_step and self.mode == "every" else 1)   # "every_step": 1
         self.engine_label = engine_label
         self.smallest = smallest              # () -> (radius, id) or None
         self.reach = reach                    # (rebuild) -> Reach.get's (onset, loading) or None

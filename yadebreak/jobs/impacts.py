@@ -40,7 +40,8 @@ def single(args):
 
     def write(results, end_reason, end_message):
         """summary.json and, if an energy is done, the plot."""
-        summary = {"material": mat.name, "size": args.size, "target": args.target,
+        summary = {"material": mat.name, "size": args.size, "shape": args.shape,
+                   "target": args.target,
                    "share_e": mat.energy_partition(target), "results": results,
                    "runtime_s": time.time() - start, "end_reason": end_reason,
                    "end_message": end_message}
@@ -80,7 +81,7 @@ def _impacts_at(args, mat, target, k, energy, out, start):
     tally, brk = scenes.single_impacts(
         args.material, args.size, speed, args.particles, args.scene_particles, args.seed + k,
         target=args.target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
-        jobs=args.jobs, **job_options.attach_options("single_impact", args))
+        jobs=args.jobs, shape=args.shape, **job_options.attach_options("single_impact", args))
     share = mat.energy_partition(target)
     result = reports.breakage_result_of(tally, mat, energy, target)
     intact = [e for e in tally.first if e["kind"] == "damage"]

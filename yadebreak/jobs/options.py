@@ -273,6 +273,9 @@ SINGLE_IMPACT = laboratory_test(5.5e-3, [
     _target_option(),
     numbers("energies", "100,200,400", "J/kg", "specific impact energies Ek/mp = v^2/2",
             lo=0, lo_open=True),
+    choice("shape", "sphere", ("sphere", "polyhedra"), "particle shape: spheres, or random "
+           "convex polyhedra of sieve size --size on YADE's volumetric law, broken into their "
+           "cells (docs/polyhedra.md)"),
 ], "out/single_impact", _KEEPING_ENERGIES, "energies", engine=("replace",),
     check=lambda args: _check_specific_energies(args, "energies"))
 
@@ -331,7 +334,7 @@ def attach_options(job, args, **more):
 
 #: script options added since a checkpoint could have been written, at the value that gives the
 #: behaviour of the scripts before them: a checkpoint without them resumes at that value
-ADDED_OPTIONS = {"break_at": "threshold", "dummy_stiffness": 1.0}
+ADDED_OPTIONS = {"break_at": "threshold", "dummy_stiffness": 1.0, "shape": "sphere"}
 
 
 def arguments_of_today(saved, now):

@@ -13,6 +13,8 @@ import numpy as np
 from yadebreak.model import placement
 from yadebreak.engine import add_materials, attach, run_steps
 from yadebreak.engine.parts.rolling import install_rolling
+from yadebreak.engine.cells_replacement import body_kinetic_energy
+from yadebreak.scenes.polyhedra import volumetric_impact_scene
 from yadebreak.adapter.yade_api import O, utils, wrapper as _w
 from yadebreak.process.files import append_whole
 from yadebreak.process.signals import stop_point, stop_points
@@ -75,7 +77,7 @@ def scene_seed(seed, scene):
 
 def single_impacts(material, size, speed, particles, per_scene, seed, target="steel",
                    event_log=None, on_scene=None, max_steps=200000, jobs=1,
-                   wait_for_arrivals=False, pool=None, **options):
+                   wait_for_arrivals=False, pool=None, shape="sphere", **options):
     """`particles` particles fired at `speed` (m/s) normally at a plate, `per_scene` at a time in
     independent scenes, each run to its own end (run_until_rebound with its controller).
 
@@ -93,9 +95,11 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     (progress lines). A scene stops after max_steps at the latest (counted in
     tally.scenes_at_step_limit). `material`: a name or path (workers get it as text). Returns
     (reports.ImpactTally, with the steps of every scene; the last scene's controller, None with
-    workers). wait_for_arrivals: see run_until_rebound."""
+    workers). wait_for_arrivals: see run_until_rebound. shape: "sphere" (impact_scene) or
+    "polyhedra" (random convex polyhedra of sieve size `size` on YADE's volumetric law:
+    scenes.polyhedra.volumetric_impact_scene)."""
     spec = impact_spec(material, size, speed, particles, per_scene, seed, target, max_steps,
-                       wait_for_arrivals, **options)
+                       wait_for_arrivals, shape, **options)
     if pool is not None:
         return pool.collect(pool.submit(spec, event_log), on_scene), None
     if jobs > 1 and len(spec["counts"]) > 1:
@@ -107,12 +111,19 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     return run_scenes(spec, range(len(spec["counts"])), event_log, on_scene)
 
 
+#: the particle shapes of single impacts: the scene builder of each
+SHAPES = ("sphere", "polyhedra")
+
+
 def impact_spec(material, size, speed, particles, per_scene, seed, target="steel",
-                max_steps=200000, wait_for_arrivals=False, **options):
+                max_steps=200000, wait_for_arrivals=False, shape="sphere", **options):
     """single_impacts' arguments as plain JSON (what a worker process runs scenes from)."""
+    if shape not in SHAPES:
+        raise ValueError(f"shape = {shape!r}: accepted {SHAPES}")
     return {"material": str(material), "size": size, "speed": speed, "seed": seed,
             "target": target, "max_steps": max_steps, "options": options,
-            "counts": _scene_counts(particles, per_scene), "wait_for_arrivals": wait_for_arrivals}
+            "counts": _scene_counts(particles, per_scene), "wait_for_arrivals": wait_for_arrivals,
+            "shape": shape}
 
 
 def drop_weight_spec(material, size, specific_energy, particles, per_scene, seed, max_time,
@@ -151,9 +162,11 @@ def run_scenes(spec, which, event_log=None, on_scene=None):
             ran, limited = run_drop_weight(brk, ids, strikers, spec["max_time"])
             brk.finish()
         else:
-            brk, ids = impact_scene(spec["material"], spec["size"], [spec["speed"]] * counts[k],
-                                    target=spec["target"], seed=seed, event_log=log_here,
-                                    **spec["options"])
+            build = (volumetric_impact_scene if spec.get("shape") == "polyhedra"
+                     else impact_scene)
+            brk, ids = build(spec["material"], spec["size"], [spec["speed"]] * counts[k],
+                             target=spec["target"], seed=seed, event_log=log_here,
+                             **spec["options"])
             initial_mass = brk.total_mass()
             ran = run_until_rebound(ids, max_steps=spec["max_steps"], brk=brk,
                                     wait_for_arrivals=spec.get("wait_for_arrivals", False))
@@ -192,7 +205,7 @@ def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None, wait_for_
     fired = [O.bodies[i] for i in ids if i < len(O.bodies) and O.bodies[i] is not None]
     speed = max((b.state.vel.norm() for b in fired), default=0.0)
     follow = brk is not None and speed > 0.0
-    quiet = 5.0 * _loading_time(fired[0], speed) if follow else None
+    quiet = 5.0 * _loading_time(fired[0], speed, brk) if follow else None
     done_steps = 0
     with stop_points():                  # a script's SIGINT, SIGTERM: stop between the checks
         while done_steps < max_steps:
@@ -207,9 +220,15 @@ def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None, wait_for_
     return done_steps
 
 
-def _loading_time(b, speed):
-    return float(placement.hertz_loading_time(b.shape.radius, b.material.density, b.material.young,
-                                              b.material.poisson, speed))
+def _loading_time(b, speed, brk):
+    """The Hertz loading time (s) of body b at `speed`; a polyhedron's as the sphere of its
+    tracked size and its material file's (a volumetric contact is shorter: a longer wait)."""
+    if isinstance(b.shape, _w.Sphere):
+        return float(placement.hertz_loading_time(b.shape.radius, b.material.density,
+                                                  b.material.young, b.material.poisson, speed))
+    mat = brk.material[brk.bodies.label_of(b.id)]
+    return float(placement.hertz_loading_time(brk.bodies[b.id].radius, mat.density,
+                                              mat.young_modulus, mat.poisson_ratio, speed))
 
 
 def _last_breakage(brk):
@@ -248,7 +267,9 @@ def _touching(i):
 
 
 def _kinetic(b):
-    """Kinetic energy (J) of a sphere: translation and spin (I = 2/5 m r^2)."""
+    """Kinetic energy (J) of a body: translation and spin (a sphere's I = 2/5 m r^2)."""
+    if not isinstance(b.shape, _w.Sphere):
+        return body_kinetic_energy(b)
     return b.state.mass * (0.5 * b.state.vel.squaredNorm()
                            + 0.2 * (b.shape.radius * b.state.angVel.norm()) ** 2)
 

@@ -10,6 +10,8 @@ particles hitting a plate 60 us per step contact by contact, 196 us with numpy; 
 (44 contacts) 208 against 303 us; a bed of 5 layers (203 contacts) 2095 against 1366 us. Per read
 alone: 4 contacts 9 against 64 us, 44 contacts 65 against 107 us, 203 contacts 308 against 281
 us. Both call the physics of a contact (law.py) on floats or on arrays.
+Polyhedra on YADE's volumetric law take a read of their own (volumetric.py): the work of the
+force over the approach of the bodies' material points.
 Duck-typed on YADE's interaction container, geometry and physics objects; no yade import.
 """
 from __future__ import annotations
@@ -19,6 +21,7 @@ import numpy as np
 from yadebreak.engine.contacts.arrays import ArrayRead
 from yadebreak.engine.contacts.each import read_each
 from yadebreak.engine.contacts.law import HertzMindlinWork, total_work
+from yadebreak.engine.contacts.volumetric import held_share, held_total, read_volumetric
 from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OVERLAP, SHARE_A, SHARE_B,
                                              SHEAR_WORK, WORK, ContactTable)
 
@@ -28,14 +31,21 @@ from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OVERLAP, SHARE_
 SMALL = 150
 #: stored_share takes a body's rows at once from this many on
 VECTOR_ROWS = 8
+#: the contact laws whose work a reader counts
+LAWS = ("hertz_mindlin", "volumetric")
 
 
 class ContactReader:
     """The contacts of tracked bodies (`table`, one row per contact), read when the schedule
     says, and what the engine tells them between reads (erased bodies, inherited pairs)."""
 
-    def __init__(self, stiffness_by_material_id, cs, emin):
-        self.stiffness = stiffness_by_material_id     # YADE material id -> Hertz stiffness (Pa)
+    def __init__(self, stiffness_by_material_id, cs, emin, law="hertz_mindlin"):
+        if law not in LAWS:
+            raise ValueError(f"law = {law!r}: accepted {LAWS}")
+        self.stiffness = stiffness_by_material_id     # YADE material id -> the stiffness of
+        #                                               Eq. 4's shares (Pa; N/m3 on "volumetric")
+        self.volumetric = law == "volumetric"
+        self.last_time = None                         # O.time at the last read
         self.cs = cs
         self.emin = emin
         self.law = HertzMindlinWork()
@@ -55,7 +65,11 @@ class ContactReader:
         the last read; `counts()` gives the real interactions of each body id (YADE's
         numIntrsOfEachBody, in C++): with it, a read of many contacts looks for new ones only
         around the bodies whose count changed."""
-        if counts is None or len(self.table) <= self.small:
+        if self.volumetric:
+            previous = self.last_time if self.last_time is not None else now
+            loading = read_volumetric(self, interactions.all(True), bodies, tracked, now,
+                                      previous)
+        elif counts is None or len(self.table) <= self.small:
             loading = read_each(self, interactions.all(True), bodies, tracked, zeroed, now,
                                 interval, asleep)
         else:
@@ -63,6 +77,7 @@ class ContactReader:
                                         asleep, counts)
         self.inherited.clear()                 # read now or gone
         self.erased_bodies.clear()
+        self.last_time = now
         return loading
 
     # -- one body's contacts -------------------------------------------------------------------
@@ -70,6 +85,8 @@ class ContactReader:
         """Elastic energy (J) a body holds now in its counted contacts: its share of the Hertz
         energy, with kno as the law uses it (scaled for zeroed pairs)."""
         table = self.table
+        if self.volumetric:
+            return held_share(table, body, self.cs, self.emin)
         sides = table.rows_of(body)
         # a body of many contacts (a fragment in its cloud): which count, at once from the numpy
         # block; below VECTOR_ROWS the loop is the cheaper (numpy's cost per call)
@@ -84,6 +101,10 @@ class ContactReader:
                 share = value(row, SHARE_B if side else SHARE_A)
                 total += share * self.law.stored(table.physs[row].kno, overlap)
         return total
+
+    def held(self, body):
+        """Elastic energy (J) a body's volumetric contacts hold, both sides (contacts/volumetric)."""
+        return held_total(self.table, body)
 
     def _stored_share_block(self, sides):
         rows = np.fromiter((r for r, _ in sides), np.int64, len(sides))
@@ -121,8 +142,10 @@ class ContactReader:
 
     # -- saved with the scene ------------------------------------------------------------------
     def to_dict(self):
-        return {**self.table.to_dict(), "inherited": sorted(self.inherited)}
+        return {**self.table.to_dict(), "inherited": sorted(self.inherited),
+                "last_time": self.last_time}
 
     def restore(self, data):
         self.table.restore(data)
         self.inherited = {tuple(pair) for pair in data.get("inherited", ())}
+        self.last_time = data.get("last_time")
