@@ -54,10 +54,13 @@ def body_kinetic_energy(body):
     return 0.5 * (s.mass * s.vel.squaredNorm() + float(np.array(s.inertia) @ (local * local)))
 
 
-def world_cells(frag, pose, mass):
+def world_cells(frag, pose, mass, min_volume_fraction=0.0):
     """The Cells of a Fragmentation made in the parent's body frame (centred on its centroid),
     carried by `pose`: rotated, translated, moving with the parent's rigid field. Masses split
-    the parent's `mass` (kg) by volume, so that they sum to it to round-off."""
+    the parent's `mass` (kg) by volume, so that they sum to it to round-off. A cell of less
+    volume than `min_volume_fraction` times the cube of the smallest resolved size is not
+    resolved (Rocky's Minimum Volume Fraction for Fragment Disabling: its mass goes to the
+    ledger)."""
     local = list(frag.vertices) + list(frag.ledger_vertices)
     volumes = np.concatenate([frag.volumes, frag.ledger_volumes])
     centroids = np.concatenate([frag.centroids, frag.ledger_centroids]).reshape(-1, 3)
@@ -68,7 +71,8 @@ def world_cells(frag, pose, mass):
     for k, verts in enumerate(local):
         _, _, unit = polyhedron_mass_properties(verts)
         inertias[k] = rot @ unit @ rot.T * (masses[k] / volumes[k])
-    resolved = np.arange(len(local)) < len(frag.vertices)
+    resolved = ((np.arange(len(local)) < len(frag.vertices))
+                & (volumes >= min_volume_fraction * frag.smallest_size ** 3))
     return Cells([(v - c) @ rot.T for v, c in zip(local, centroids)], pose.position + arms, masses,
                  pose.velocity + np.cross(pose.spin, arms), inertias,
                  np.concatenate([frag.sieve_sizes, frag.ledger_sieve_sizes]), resolved)
@@ -157,7 +161,7 @@ class CellBreakage:
         local = np.array([tuple(v) for v in body.shape.v])
         frag = fragment_cells(rep.rng, local, t10, recipe.families.beta_params,
                               model.X_MIN * parent_size)
-        cells = world_cells(frag, pose, mass)
+        cells = world_cells(frag, pose, mass, rep.options.min_volume_fraction)
         material = body.material
         kinetic_before = body_kinetic_energy(body)
         O.bodies.erase(bid)

@@ -16,6 +16,7 @@ from yadebreak.model import families
 from yadebreak.analysis import reports
 from yadebreak.adapter.yade_api import O, utils
 from yadebreak.engine.contacts import ContactReader, Strongest
+from yadebreak.engine.safeguards import LargeOverlaps
 from yadebreak.criteria import criterion_for
 from yadebreak.engine.judging import Judge, Rules
 from yadebreak.engine.replacement import Recipe, Replacer
@@ -96,6 +97,8 @@ class Controller:
         self.judge = Judge(self.state, self._criterion_of, self.reader, rules,
                            record=self._record, warn_jump=self._warn_jump,
                            weakened=self.tracking.weakened)
+        self.large_overlaps = (LargeOverlaps(config.replacement.overlap_factor)
+                               if config.replacement.overlap_factor else None)
         self.last_iter = -1
         self.wall_time = {"read": 0.0, "replace": 0.0}
 
@@ -215,6 +218,8 @@ class Controller:
                                    utils.numIntrsOfEachBody)
         self.wall_time["read"] += time.perf_counter() - t0
         broken, limits = self.judge.judge(loading, interval, O.iter, self.schedule.mode == "fast")
+        if self.large_overlaps is not None:
+            broken = broken + self.large_overlaps.due(self, loading, broken)
         if broken:
             self._break_all(broken)
         self.damping.release()
@@ -252,8 +257,7 @@ class Controller:
         state, table = self.state, self.state.table
         c = table.columns
         new_dt = np.inf
-        dmin = self.config.replacement.dmin
-        dmin = dmin if dmin is not None else state.top_size / 20.0
+        dmin = self._dmin()
         for bid, ek, strongest in broken:
             if bid not in state.tracked:
                 continue
@@ -287,6 +291,10 @@ class Controller:
             self._record("breakage", bid, **event)
         self.time_step.lower(new_dt, self.reader.bodies_in_contact)
         self.wall_time["replace"] += time.perf_counter() - t0
+
+    def _dmin(self):
+        dmin = self.config.replacement.dmin
+        return dmin if dmin is not None else self.state.top_size / 20.0
 
     def break_body(self, body_id, ratio=1.0, direction=(0.0, 0.0, 1.0)):
         """Break a breakable body now, as if stressed to ratio = Ek'/(m E) (its criterion's t10')

@@ -175,6 +175,15 @@ OPTIONS = (
     _row("zeroing_tolerance", "replacement", 0.05, "number", "-",
          "a zeroed pair that opens with no force is revisited only when its overlap may have "
          "shrunk by this share of itself (0: every step)", 0, 1, hi_open=True),
+    _row("overlap_factor", "replacement", None, "number", "-",
+         "Rocky's breakage for large deformations: a tracked body whose contact overlap (on "
+         "the volumetric law, the approach) passes this times dmin breaks at once at its "
+         "present energy, or goes to the fines ledger if its volume is under 3 dmin^3", 0,
+         lo_open=True, none="off", token=0.0),
+    _row("min_volume_fraction", "replacement", 0.25, "number", "-",
+         "Rocky's 'Minimum Volume Fraction for Fragment Disabling': a polyhedron's cell whose "
+         "volume is under this times the cube of the event's smallest resolved size goes to "
+         "the fines ledger (0: none)", 0, 1),
     _row("family_seed", "replacement", 0, "count", "-",
          "seed of the family tables (not of the run: that is `seed`)", 0),
     # time step and fragment damping
@@ -228,6 +237,8 @@ class Replacement:
     local_damping: float
     zero_overlaps: bool
     zeroing_tolerance: float
+    overlap_factor: float | None
+    min_volume_fraction: float
     family_seed: int
 
 

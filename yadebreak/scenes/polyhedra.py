@@ -191,8 +191,8 @@ def polyhedra_engines(ip2, gravity=(0.0, 0.0, 0.0), verlet_dist=0.0, label="law"
 def volumetric_engines(gravity=(0.0, 0.0, 0.0), verlet_dist=0.0, label="law"):
     """YADE's volumetric law for polyhedra (Elias 2014): a normal force kn V along the normal of
     the intersection (volume V), kn = PolyhedraMat.young of the pair in series (N/m3, not a
-    Young's modulus); polyhedra, walls and facets. For comparison (contact_law benchmark): the
-    engine's contact reader does not read PolyhedraGeom."""
+    Young's modulus); polyhedra, walls and facets. The engine reads it
+    (engine/contacts/volumetric.py)."""
     return [
         _w.ForceResetter(),
         _w.InsertionSortCollider([_w.Bo1_Polyhedra_Aabb(), _w.Bo1_Wall_Aabb(),
