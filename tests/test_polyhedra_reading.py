@@ -79,8 +79,9 @@ def test_held_plus_kinetic_energy_is_the_energy_fired_closer_at_a_finer_step():
 
 def test_a_cube_broken_on_the_plate_creates_no_energy():
     """3000 J/kg face first: it breaks on the plate into cells that overlap the plate as it did
-    (no zeroing: the force of the law is kn times the volume each cell shares with it). Each
-    breakage leaves the kinetic energy as it was; to the end of the cascade, the kinetic energy
+    (no zeroing: the force of the law is kn times the volume each cell shares with it), and
+    its cells break again. Each breakage leaves the kinetic energy as it was, no cell faster
+    than the parent's rigid motion at its centroid; to the end of the cascade, the kinetic energy
     of the bodies plus the ledger's never exceeds the energy fired by more than the integration
     error measured above (3 %), and the mass is the cube's to round-off."""
     from yade import O, utils
@@ -94,6 +95,8 @@ def test_a_cube_broken_on_the_plate_creates_no_energy():
     assert breakages and breakages[0]["id"] == cid
     for e in breakages:
         assert e["kinetic_energy_after"] == pytest.approx(e["kinetic_energy_before"], rel=1e-12)
+        assert e["fragment_speed_excess"] <= 1e-9 * math.sqrt(2.0 * 3000.0)   # rigid motion only
+    assert max(e["generation"] for e in breakages) >= 1        # fragments break again
     assert highest <= 1.03 * energy
     bodies = sum(b.state.mass for b in O.bodies if b is not None and b.id != 0)
     assert bodies + brk.ledger.total_mass() == pytest.approx(mass, rel=1e-12)

@@ -122,6 +122,10 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     ctl.state.log.start()
     ctl.damping.apply_at_attach()
     user_dt = None if O.dt == YADE_DEFAULT_DT else O.dt
+    if law == "volumetric" and user_dt is None:
+        ctl._warn_once("dt", f"O.dt is YADE's default {O.dt:g} s: the engine sets no time step "
+                       "for polyhedra on the volumetric law; set O.dt before attach (the "
+                       "scenes use 1 % of a particle's Rayleigh time: docs/polyhedra.md)")
     ctl.time_step.at_attach(smallest_rayleigh_time(), user_dt)
     ctl.last_iter = O.iter - 1
     protocol.install(BreakageEngine(label, ctl), engines)
