@@ -21,7 +21,7 @@ import numpy as np
 from yadebreak.engine.contacts.arrays import ArrayRead
 from yadebreak.engine.contacts.each import read_each
 from yadebreak.engine.contacts.law import HertzMindlinWork, total_work
-from yadebreak.engine.contacts.volumetric import held_share, held_total, read_volumetric
+from yadebreak.engine.contacts.volumetric import held_share, held_total
 from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OVERLAP, SHARE_A, SHARE_B,
                                              SHEAR_WORK, WORK, ContactTable)
 
@@ -65,13 +65,10 @@ class ContactReader:
         the last read; `counts()` gives the real interactions of each body id (YADE's
         numIntrsOfEachBody, in C++): with it, a read of many contacts looks for new ones only
         around the bodies whose count changed."""
-        if self.volumetric:
-            previous = self.last_time if self.last_time is not None else now
-            loading = read_volumetric(self, interactions.all(True), bodies, tracked, now,
-                                      previous)
-        elif counts is None or len(self.table) <= self.small:
+        if self.volumetric or counts is None or len(self.table) <= self.small:
             loading = read_each(self, interactions.all(True), bodies, tracked, zeroed, now,
-                                interval, asleep)
+                                interval, asleep,
+                                self.last_time if self.last_time is not None else now)
         else:
             loading = self._read_arrays(interactions, bodies, tracked, zeroed, now, interval,
                                         asleep, counts)

@@ -1,4 +1,4 @@
-"""A read of YADE's volumetric law for convex polyhedra (Law2_PolyhedraGeom_PolyhedraPhys_Volumetric:
+"""Reading a contact of YADE's volumetric law for convex polyhedra (Law2_PolyhedraGeom_PolyhedraPhys_Volumetric:
 a normal force kn V, V the volume the two bodies share, no dashpot).
 
 PolyhedraGeom gives no approach to integrate the force over (docs/polyhedra.md), so the approach
@@ -15,14 +15,11 @@ integral over loading and unloading, the elastic energy the contact holds (the l
 the normal direction), in HELD. OVERLAP holds the approach since the contact began (m).
 
 Read every step (the schedule reads polyhedra on this law every step: between reads the approach
-is extrapolated from the velocities of one instant). Duck-typed on YADE's objects; no yade import.
+is extrapolated from the velocities of one instant), by the scalar read (each.py), which calls
+fresh() and advance() for each contact. Duck-typed on YADE's objects; no yade import.
 """
 from __future__ import annotations
 
-import numpy as np
-
-from yadebreak.engine.contacts.law import own_share
-from yadebreak.engine.contacts.loading import Loading, StrongestContacts
 from yadebreak.engine.contacts.table import (FORCE, OFFSET_A, OFFSET_B, OVERLAP, OVERLAP_BEFORE,
                                              SHARE_A, SHARE_B, TIME_READ, WORK, fresh_row)
 
@@ -40,7 +37,18 @@ def approach_rate(geom, state_a, state_b):
     return -relative.dot(geom.normal)
 
 
-def _advance(row, geom, phys, state_a, state_b, now):
+def fresh(stiffness, bodies, a, b, phys, now, previous, inherited):
+    """The row of a contact seen first at this read: it began after the last read (at
+    `previous`, s), its force growing from nothing since; an `inherited` one (a fragment's,
+    overlapping as its parent did) and any at the first read (previous == now) count from
+    their present force."""
+    row = fresh_row(stiffness, bodies, a, b, previous)
+    if inherited or previous == now:
+        row[FORCE], row[TIME_READ] = phys.normalForce.norm(), now
+    return row
+
+
+def advance(row, geom, phys, state_a, state_b, now):
     """Bring a row to the present; returns whether its loading work grew."""
     force = phys.normalForce.norm()
     step = approach_rate(geom, state_a, state_b) * (now - row[TIME_READ])
@@ -53,60 +61,6 @@ def _advance(row, geom, phys, state_a, state_b, now):
         row[WORK] += work
         return True
     return False
-
-
-def read_volumetric(reader, real, bodies, tracked, now, previous):
-    """One read of `real` (YADE's real interactions) into reader.table; returns the Loading.
-    `previous`: the time (s) of the last read; a contact seen first now began after it (its force
-    grew from nothing since then), but an inherited one (a fragment's, overlapping as its parent
-    did) and any at the first read (previous == now) count from their present force."""
-    table, cs, emin, inherited = reader.table, reader.cs, reader.emin, reader.inherited
-    index = table.index
-    if index is None:
-        index = dict(zip(zip(table.a.tolist(), table.b.tolist()), range(len(table.a))))
-    old_rows = table.row_lists()
-    a_list, b_list, rows, geoms, physs = [], [], [], [], []
-    new_index, energy, found, grew, by_body = {}, {}, {}, set(), {}
-    for inter in real:
-        a, b = inter.id1, inter.id2
-        in_a = a in tracked
-        in_b = b in tracked
-        if not (in_a or in_b):
-            continue
-        geom, phys = inter.geom, inter.phys
-        j = index.get((a, b))
-        if j is not None:
-            row = old_rows[j]
-        else:
-            row = fresh_row(reader.stiffness, bodies, a, b, previous)
-            pair = (a, b) if a < b else (b, a)
-            if previous == now or (inherited and pair in inherited):
-                row[FORCE], row[TIME_READ] = phys.normalForce.norm(), now
-        if _advance(row, geom, phys, bodies[a].state, bodies[b].state, now):
-            if in_a:
-                grew.add(a)
-            if in_b:
-                grew.add(b)
-        k = len(rows)
-        new_index[(a, b)] = k
-        rows.append(row)
-        a_list.append(a)
-        b_list.append(b)
-        geoms.append(geom)
-        physs.append(phys)
-        for side, body, other, offset, share_col, sign in ((in_a, a, b, OFFSET_A, SHARE_A, 1.0),
-                                                           (in_b, b, a, OFFSET_B, SHARE_B, -1.0)):
-            if not side:
-                continue
-            by_body.setdefault(body, []).append((k, 0 if sign > 0 else 1))
-            counted, share = own_share(row[WORK], row[offset], row[share_col], emin)
-            if counted:
-                energy[body] = energy.get(body, 0.0) + share
-                if share > found.get(body, (0.0,))[0]:
-                    found[body] = (share, k, sign, other)
-    table.set(np.array(a_list, np.int64), np.array(b_list, np.int64), None, geoms, physs,
-              rows=rows, by_body=by_body, index=new_index)
-    return Loading(energy, StrongestContacts(found, geoms), grew)
 
 
 def held_share(table, body, cs, emin):
