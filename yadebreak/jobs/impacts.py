@@ -20,7 +20,7 @@ from yadebreak import engine, scenes
 from yadebreak.scenes import view
 from yadebreak.analysis import reports
 from yadebreak.model.materials import load_material
-from yadebreak.jobs import skeleton
+from yadebreak.jobs import paraview, skeleton
 from yadebreak.jobs.lifecycle import (ScriptError, progress, resume_arguments, save_figure,
                                        time_left, write_atomic)
 from yadebreak.jobs import options as job_options
@@ -81,7 +81,8 @@ def _impacts_at(args, mat, target, k, energy, out, start):
     tally, brk = scenes.single_impacts(
         args.material, args.size, speed, args.particles, args.scene_particles, args.seed + k,
         target=args.target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
-        jobs=args.jobs, shape=args.shape, **job_options.attach_options("single_impact", args))
+        jobs=args.jobs, shape=args.shape, watch=_frames(args, out, energy),
+        **job_options.attach_options("single_impact", args))
     share = mat.energy_partition(target)
     result = reports.breakage_result_of(tally, mat, energy, target)
     intact = [e for e in tally.first if e["kind"] == "damage"]
@@ -93,6 +94,16 @@ def _impacts_at(args, mat, target, k, energy, out, start):
         "mass_relative_error": tally.mass_relative_error})
     progress(f"{reports.result_line(result)}, {tally.steps} steps, {time.time() - start:.1f} s")
     return brk, result
+
+
+def _frames(args, out, energy):
+    """watch() of the first scene at `energy`: a ParaView series in <out>/paraview_<energy>
+    every --vtk-interval s of simulated time (None without one)."""
+    if not args.vtk_interval:
+        return None
+    folder = out / f"paraview_{energy:g}"
+    return lambda scene, brk: (paraview.series(folder, brk, args.vtk_interval) if scene == 0
+                               else None)
 
 
 # -- drop-weight tests ----------------------------------------------------------------------------

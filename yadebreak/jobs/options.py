@@ -276,6 +276,8 @@ SINGLE_IMPACT = laboratory_test(5.5e-3, [
     choice("shape", "sphere", ("sphere", "polyhedra"), "particle shape: spheres, or random "
            "convex polyhedra of sieve size --size on YADE's volumetric law, broken into their "
            "cells (docs/polyhedra.md)"),
+    number("vtk_interval", 0.0, "s", "simulated time between ParaView frames of the first "
+           "scene of each energy, in <out>/paraview_<energy> (0: none; with --jobs 1)", lo=0),
 ], "out/single_impact", _KEEPING_ENERGIES, "energies", engine=("replace",),
     check=lambda args: _check_specific_energies(args, "energies"))
 
@@ -334,7 +336,8 @@ def attach_options(job, args, **more):
 
 #: script options added since a checkpoint could have been written, at the value that gives the
 #: behaviour of the scripts before them: a checkpoint without them resumes at that value
-ADDED_OPTIONS = {"break_at": "threshold", "dummy_stiffness": 1.0, "shape": "sphere"}
+ADDED_OPTIONS = {"break_at": "threshold", "dummy_stiffness": 1.0, "shape": "sphere",
+                 "vtk_interval": 0.0}
 
 
 def arguments_of_today(saved, now):

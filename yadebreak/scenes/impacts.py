@@ -77,7 +77,8 @@ def scene_seed(seed, scene):
 
 def single_impacts(material, size, speed, particles, per_scene, seed, target="steel",
                    event_log=None, on_scene=None, max_steps=200000, jobs=1,
-                   wait_for_arrivals=False, pool=None, shape="sphere", **options):
+                   wait_for_arrivals=False, pool=None, shape="sphere", watch=None,
+                   **options):
     """`particles` particles fired at `speed` (m/s) normally at a plate, `per_scene` at a time in
     independent scenes, each run to its own end (run_until_rebound with its controller).
 
@@ -97,7 +98,9 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     (reports.ImpactTally, with the steps of every scene; the last scene's controller, None with
     workers). wait_for_arrivals: see run_until_rebound. shape: "sphere" (impact_scene) or
     "polyhedra" (random convex polyhedra of sieve size `size` on YADE's volumetric law:
-    scenes.polyhedra.volumetric_impact_scene)."""
+    scenes.polyhedra.volumetric_impact_scene). watch(scene, controller): a callable to call
+    between checks of that scene's run and close() at its end, or None (in this process only:
+    with workers it is not called)."""
     spec = impact_spec(material, size, speed, particles, per_scene, seed, target, max_steps,
                        wait_for_arrivals, shape, **options)
     if pool is not None:
@@ -108,7 +111,7 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
             return own.collect(own.submit(spec, event_log), on_scene), None
     if event_log is not None:
         Path(event_log).write_text("")
-    return run_scenes(spec, range(len(spec["counts"])), event_log, on_scene)
+    return run_scenes(spec, range(len(spec["counts"])), event_log, on_scene, watch)
 
 
 #: the particle shapes of single impacts: the scene builder of each
@@ -142,9 +145,10 @@ def _scene_counts(particles, per_scene):
                                                      if particles % per_scene else [])
 
 
-def run_scenes(spec, which, event_log=None, on_scene=None):
+def run_scenes(spec, which, event_log=None, on_scene=None, watch=None):
     """The scenes `which` of an impact_spec or drop_weight_spec, one after the other, their
-    events appended to `event_log`: (tally, the last scene's controller)."""
+    events appended to `event_log`: (tally, the last scene's controller). watch: see
+    single_impacts."""
     from yadebreak.analysis.reports import ImpactTally
     tally = ImpactTally(spec["size"])
     log = None if event_log is None else Path(event_log)
@@ -168,8 +172,12 @@ def run_scenes(spec, which, event_log=None, on_scene=None):
                              target=spec["target"], seed=seed, event_log=log_here,
                              **spec["options"])
             initial_mass = brk.total_mass()
+            watcher = watch(k, brk) if watch is not None else None
             ran = run_until_rebound(ids, max_steps=spec["max_steps"], brk=brk,
-                                    wait_for_arrivals=spec.get("wait_for_arrivals", False))
+                                    wait_for_arrivals=spec.get("wait_for_arrivals", False),
+                                    on_check=watcher)
+            if watcher is not None:
+                watcher.close()
             limited = ran >= spec["max_steps"]
         tally.steps += ran
         tally.scenes_at_step_limit += int(limited)
@@ -184,7 +192,8 @@ def run_scenes(spec, which, event_log=None, on_scene=None):
     return tally, brk
 
 
-def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None, wait_for_arrivals=False):
+def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None, wait_for_arrivals=False,
+                      on_check=None):
     """Run until the listed bodies have left the plate (moving away, touching nothing), or
     max_steps. With the controller `brk`, also until their fragments are done: fragments go on
     breaking while they are loaded, so the run does not stop when the original particles have
@@ -201,7 +210,8 @@ def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None, wait_for_
     for it faster than that 10 % (_arrival_pending). Without it a fragment thrown from the top of
     a broken parent, still in flight towards the plate, is cut off: measured, 29 mm copper ore
     at 1000 J/kg (seed 3), the run stopped at 121 us with a fragment heading down at 33 m/s;
-    20,000 more steps gave 4 breakages instead of 1."""
+    20,000 more steps gave 4 breakages instead of 1. on_check(): called after every check_every
+    steps (a ParaView series)."""
     fired = [O.bodies[i] for i in ids if i < len(O.bodies) and O.bodies[i] is not None]
     speed = max((b.state.vel.norm() for b in fired), default=0.0)
     follow = brk is not None and speed > 0.0
@@ -211,6 +221,8 @@ def run_until_rebound(ids, max_steps=200000, check_every=50, brk=None, wait_for_
         while done_steps < max_steps:
             run_steps(check_every)
             done_steps += check_every
+            if on_check is not None:
+                on_check()
             stop_point()
             if all(_left(i) for i in ids) and (
                     not follow or _all_away(0.1 * speed)
