@@ -102,14 +102,19 @@ def test_a_cube_broken_on_the_plate_creates_no_energy():
     assert bodies + brk.ledger.total_mass() == pytest.approx(mass, rel=1e-12)
 
 
-def test_single_impacts_fire_polyhedra():
+def test_single_impacts_fire_polyhedra(tmp_path):
     """The single-impact scenes with shape="polyhedra": one random convex particle of 20 mm
     sieve size, 300 J/kg; its first event counts Eq. 4's share of the energy it absorbed, no
     more than SHARE x 300 J/kg (a spinning body keeps some as rotation; 2 % for the step), and
-    the tally's mass is conserved."""
+    the tally's mass is conserved. A watch writes its ParaView frames: the polyhedron's faces."""
+    from yadebreak.jobs import paraview
     from yadebreak.scenes import impacts
-    tally, brk = impacts.single_impacts("copper_ore", SIZE, math.sqrt(600.0), 1, 1, 5,
-                                        shape="polyhedra")
+    folder = tmp_path / "paraview"
+    tally, brk = impacts.single_impacts(
+        "copper_ore", SIZE, math.sqrt(600.0), 1, 1, 5, shape="polyhedra",
+        watch=lambda scene, brk: paraview.series(folder, brk, 1e-5))
+    frames = sorted(folder.glob("polyhedra_*.vtp"))
+    assert len(frames) >= 2 and "<Polys>" in frames[0].read_text()
     assert tally.particles == 1
     first = tally.first[0]
     assert 0.3 * SHARE * 300.0 < first["specific_energy"] <= 1.02 * SHARE * 300.0
