@@ -245,3 +245,30 @@ def test_a_vanished_cell_is_revived():
     assert cells.laguerre_cells(CUBE, seeds, start)[3] is None
     sol = cells.solve_weights(CUBE, seeds, target, weights=start)
     assert sol.converged and sol.max_relative_error <= 1e-3
+
+
+def test_cells_of_random_convex_parents_follow_the_progeny_distribution():
+    """200 breakages of random convex parents (random_convex_vertices, the single-impact
+    scenes' shape) at t10' drawn uniformly in 2-20 % (the DEM's: primary breakages at 2-5 %,
+    successive ones higher), smallest resolved size the engine's X_MIN of the parent: the mean
+    passing at 1/4, 1/10, 1/25 of the parent's sieve size against the mean of Eq. 10 at each
+    breakage's own t10', 15 % relative (2 points absolute below 10 %). Measured 25.1 / 10.9 / 5.8
+    % against 25.9 / 11.0 / 5.9 %, standard errors 0.9 / 0.4 / 0.2 points.
+
+    At 1/2 the cells pass 45.7 % against 56.1 % (60.9 against 72.4 % for the 97 at t10' >= 10
+    %; 7.4 against 14.8 % over 40 at 2 %): a cell with a large share of a rounded parent sieves
+    coarser than the volume-to-size relation measured on a cube says (it takes the parent's
+    breadth). Not held here; docs/polyhedra.md gives the figures."""
+    beta = load_material("copper_ore").beta_params
+    rng = np.random.default_rng(200)
+    sieves = np.array([1 / 2, 1 / 4, 1 / 10, 1 / 25])
+    got, want = [], []
+    for _ in range(200):
+        parent = cells.random_convex_vertices(1.0, rng)
+        t10 = rng.uniform(2.0, 20.0)
+        frag = cells.fragment_cells(rng, parent, t10, beta, model.X_MIN * cells.sieve_size(parent))
+        got.append(100.0 * frag.passing(sieves * frag.parent_sieve_size))
+        want.append(model.progeny_passing(t10, beta, sieves))
+    passing, target = np.mean(got, axis=0), np.mean(want, axis=0)
+    allowed = np.where(target < 10.0, 2.0, 0.15 * target)
+    assert np.all(np.abs(passing - target)[1:] <= allowed[1:]), (passing, target)

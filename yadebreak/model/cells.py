@@ -27,7 +27,7 @@ from yadebreak.model.equations import fines_passing, progeny_passing
 
 __all__ = ['ConvexPolyhedron', 'convex_polyhedron', 'polyhedron_mass_properties', 'sieve_size',
            'laguerre_cells', 'WeightSolution', 'solve_weights', 'progeny_law', 'target_sizes',
-           'place_seeds', 'Fragmentation', 'fragment_cells', 'cell_volume', 'CELL_SHAPE_FACTOR',
+           'place_seeds', 'Fragmentation', 'fragment_cells', 'random_convex_vertices', 'cell_volume', 'CELL_SHAPE_FACTOR',
            'CELL_SHAPE_EXPONENT', 'LAWS']
 
 #: Volume V of the cells fragment_cells makes against their sieve size b, both relative to the
@@ -136,6 +136,17 @@ def convex_polyhedron(vertices):
     volume, centroid, inertia = polyhedron_mass_properties(points)
     size = float(_flush_box_extents(points, hull)[1])
     return ConvexPolyhedron(points[hull.vertices], volume, centroid, inertia, size)
+
+
+def random_convex_vertices(size, rng, points=24, roughness=0.25):
+    """Vertices (m) of a random convex body about `size` across: the hull of `points` random
+    directions at radii size/2 (1 - roughness u), u uniform in [0, 1), centred on its centroid.
+    rng: a seeded numpy Generator."""
+    d = rng.normal(size=(points, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    pts = d * (size / 2.0) * (1.0 - roughness * rng.random(points))[:, None]
+    body = convex_polyhedron(pts)
+    return body.vertices - body.centroid
 
 
 # --------------------------------------------------------------------------- power cells

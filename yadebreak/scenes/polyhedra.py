@@ -24,7 +24,7 @@ from yadebreak.engine import add_materials, attach
 from yadebreak.engine.cells_replacement import skipped_turn
 from yadebreak import model
 from yadebreak.model import placement
-from yadebreak.model.cells import convex_polyhedron, sieve_size
+from yadebreak.model.cells import convex_polyhedron, random_convex_vertices, sieve_size
 
 #: the three ways a body can meet a plate first (orientation())
 CONTACTS = ("face", "edge", "corner")
@@ -107,17 +107,6 @@ def plate(material, side=0.1, thickness=0.01, top=0.0, centre=(0.0, 0.0)):
     line of centres: a body must hit the plate above its centre to be pushed straight up."""
     return polyhedron(box_vertices(side, side, thickness), material,
                       (centre[0], centre[1], top - thickness / 2.0), fixed=True)
-
-
-def random_convex_vertices(size, rng, points=24, roughness=0.25):
-    """Vertices (m) of a random convex body about `size` across: the hull of `points` random
-    directions at radii size/2 (1 - roughness u), u uniform in [0, 1), centred on its centroid.
-    rng: a seeded numpy Generator."""
-    d = rng.normal(size=(points, 3))
-    d /= np.linalg.norm(d, axis=1)[:, None]
-    pts = d * (size / 2.0) * (1.0 - roughness * rng.random(points))[:, None]
-    body = convex_polyhedron(pts)
-    return body.vertices - body.centroid
 
 
 def _rotation_to_down(direction):
