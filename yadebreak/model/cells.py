@@ -298,12 +298,20 @@ def _newton_step(h, gradient, alive):
     return step
 
 
+#: solve_weights stops, stalled, after this many tessellations (each trial step is one):
+#: measured, a breakage of a cube into 218 cells (t10' 10 %, down to 0.1 of its size) that never
+#: met its tolerance spent 61 s on 600 of them, halving steps down to 1e-6; converging solves
+#: take 8-60
+MAX_TESSELLATIONS = 60
+
+
 def solve_weights(parent_vertices, seeds, target_volumes, tol=1e-3, max_iter=60, weights=None):
     """Weights (m^2) whose clipped power cells have the target volumes (m^3, summing to the
     parent's) within `tol` relative each: damped Newton (Kitagawa, Merigot and Thibert): a step is
     halved until every cell keeps at least half the smallest of its target and present volume and
-    the volume error shrinks. Empty cells at the start are revived (_revive). Returns a
-    WeightSolution; `converged` is False when max_iter Newton steps did not reach `tol`."""
+    the volume error shrinks; past MAX_TESSELLATIONS trials it stops, stalled. Empty cells at
+    the start are revived (_revive). Returns a WeightSolution; `converged` is False when it
+    stalled or max_iter Newton steps did not reach `tol`."""
     hull = ConvexHull(np.asarray(parent_vertices, dtype=float))
     seeds = np.asarray(seeds, dtype=float)
     target = np.asarray(target_volumes, dtype=float)
@@ -315,7 +323,7 @@ def solve_weights(parent_vertices, seeds, target_volumes, tol=1e-3, max_iter=60,
             break
         w = _revive(w, seeds, vol <= 0.0, radius)
         cells, vol, faces, cent = _power_cells(hull, seeds, w, hints=np.where(np.isnan(cent), seeds, cent))
-    it = 0
+    it = made = 0
     for it in range(1, max_iter + 1):
         err = np.abs(vol - target) / target
         if err.max() <= tol:
@@ -326,10 +334,13 @@ def solve_weights(parent_vertices, seeds, target_volumes, tol=1e-3, max_iter=60,
         tau = 1.0
         while tau > 1e-6:
             trial = _power_cells(hull, seeds, w + tau * step, hints=cent)
+            made += 1
             if (np.all(trial[1] >= floor)
                     and np.linalg.norm(target - trial[1]) <= (1.0 - 0.5 * tau) * np.linalg.norm(gradient)):
                 break
             tau *= 0.5
+        if made > MAX_TESSELLATIONS:       # stalled: the cells as they were
+            return WeightSolution(w, cells, vol, float(err.max()), it, False)
         w = w + tau * step
         cells, vol, faces, cent = trial
     err = np.abs(vol - target) / target
@@ -361,30 +372,34 @@ def cell_volume(x):
 
 def target_sizes(rng, passing, volume_of, smallest):
     """Relative sieve sizes (of the parent's) of the resolved fragments, coarse to fine, and the
-    volume fraction left below `smallest` (relative) for the ledger.
+    volume fraction passing(smallest) left below `smallest` (relative) for the ledger.
 
-    Walks the progeny curve down from 100 %: with m the mass fraction not yet given out, the next
-    fragment's size x solves passing(x) + u v(x) = m, u uniform in (0, 1) and v(x) = volume_of(x)
-    its volume fraction of the parent: the fragment takes a random place in the mass slice it
-    fills, so the mass passing every size follows the curve on average. Stops at the first x
-    below `smallest`: m goes to the ledger.
+    The sizes are drawn one by one from the number distribution of the law above `smallest`
+    (the mass in [x, x + dx] over a fragment's volume fraction v(x) = volume_of(x)), until their
+    volumes reach the 1 - passing(smallest) to give out; then every volume is scaled by the
+    same factor (at most 1) to close it, each size following its volume. Every piece is drawn
+    alike, so the mass passing each size follows the curve on average: over 400 random convex
+    parents the volumes drawn pass 1/2 and 1/4 of the parent within 1.7 and 0.2 points of Eq. 10
+    at t10' 2-20 % (a walk down the curve that gave each fragment a random place in the mass
+    slice it fills passed 8.9 % at 1/2 against 14.8 % at 2 %: a first fragment could take
+    the parent's whole size).
     """
-    grid = np.geomspace(min(smallest, 1.0) * 0.5, 1.0, 4000)
+    grid = np.geomspace(min(smallest, 1.0), 1.0, 4000)
     curve = passing(grid)
     vol = volume_of(grid)
-    sizes, m = [], 1.0
-    while m > 0.0:
-        x = float(np.interp(m, curve + rng.random() * vol, grid))
-        if x < smallest:
-            break
-        v = float(volume_of(x))
-        if v >= m:               # the last piece: it takes what is left
-            sizes.append(float(np.interp(m, vol, grid)))
-            m = 0.0
-            break
+    ledger = float(curve[0])
+    left = 1.0 - ledger
+    if left <= 0.0:
+        return np.zeros(0), 1.0
+    mid = np.sqrt(grid[1:] * grid[:-1])
+    number = np.concatenate([[0.0], np.cumsum(np.diff(curve) / volume_of(mid))])
+    sizes, volumes = [], []
+    while sum(volumes) < left:
+        x = float(np.interp(rng.random() * number[-1], number, grid))
         sizes.append(x)
-        m -= v
-    return np.array(sizes), max(m, 0.0)
+        volumes.append(float(volume_of(x)))
+    scale = left / sum(volumes)
+    return np.array([float(np.interp(v * scale, vol, grid)) for v in volumes]), ledger
 
 
 def _inside(hull, points):
@@ -464,6 +479,13 @@ def _ledger_targets(ledger_fraction, resolved_fractions):
     return np.full(count, ledger_fraction / count)
 
 
+#: fragment_cells places the seeds anew, up to PLACEMENTS times, while the weight solver ends
+#: with a cell more than FAR_OFF off its target volume (relative): measured, 1 breakage in 10 of
+#: a cube into 218 cells stalled at once with a cell 82 times its target; new seeds solved it
+PLACEMENTS = 3
+FAR_OFF = 0.1
+
+
 def fragment_cells(rng, parent_vertices, t10, beta_params, smallest_size, law="incomplete_beta",
                    tol=1e-3, max_iter=30):
     """Break a convex parent (vertices (n, 3), m) at t10' (%) into clipped Laguerre cells.
@@ -484,8 +506,14 @@ def fragment_cells(rng, parent_vertices, t10, beta_params, smallest_size, law="i
     fractions = np.concatenate([fractions, _ledger_targets(ledger, fractions)])
     fractions /= fractions.sum()          # round-off: the targets close the parent's volume
     targets = fractions * parent.volume
-    seeds = place_seeds(rng, hull, np.cbrt(3.0 * targets / (4.0 * np.pi)))
-    sol = solve_weights(parent.vertices, seeds, targets, tol=tol, max_iter=max_iter)
+    sol = None
+    for _ in range(PLACEMENTS):       # seeds placed anew while the solver stalls far off
+        seeds = place_seeds(rng, hull, np.cbrt(3.0 * targets / (4.0 * np.pi)))
+        trial = solve_weights(parent.vertices, seeds, targets, tol=tol, max_iter=max_iter)
+        if sol is None or trial.max_relative_error < sol.max_relative_error:
+            sol = trial
+        if sol.max_relative_error <= FAR_OFF:
+            break
     kept = [i for i, c in enumerate(sol.cells) if c is not None]
     props = [convex_polyhedron(sol.cells[i]) for i in kept]
     sieve = np.array([p.sieve_size for p in props])
