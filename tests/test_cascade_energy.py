@@ -24,7 +24,7 @@ def _audit(time_step, duration, whole=True):
     while view.now() < duration:
         engine.run_steps(10)
     return energy_audit.split(sum(start.kinetic.values()), energy.energy_now(brk, part),
-                              brk.events)
+                              energy_audit.events_of(brk))
 
 
 @pytest.mark.yade

@@ -31,8 +31,8 @@ Figures (--figures, comma-separated):
                weight).
   damping      Fig. 19: the same, single impacts with global damping 0 ... 0.3 (1 % RT).
                Figures share runs with the same settings (each runs once).
-  energy       Where the energy of a cascade goes: each material at 29 mm, 150, 1000 and
-               3000 J/kg, 2 particles each (quick: copper ore, 1000 J/kg, 1), the impact's
+  energy       Where the energy of a cascade goes: each material at 29 mm, 150 and 1000
+               J/kg, 1 particle each (quick: copper ore, 1000 J/kg, 1), the impact's
                kinetic energy split into where it ends, per breakage generation and in total
                (energy_audit.py; YADE's energy tracking on, in this process).
 
