@@ -31,6 +31,10 @@ Figures (--figures, comma-separated):
                weight).
   damping      Fig. 19: the same, single impacts with global damping 0 ... 0.3 (1 % RT).
                Figures share runs with the same settings (each runs once).
+  energy       Where the energy of a cascade goes: each material at 29 mm, 150 and 1000
+               J/kg, 1 particle each (quick: copper ore, 1000 J/kg, 1), the impact's
+               kinetic energy split into where it ends, per breakage generation and in total
+               (energy_audit.py; YADE's energy tracking on, in this process).
 
 --quick 1: copper ore only, few particles, 2-3 energies (Figs. 9-10: one level, the 50 %; Fig.
 11: 5 impacts, gamma 5 and 10; Figs. 13-19: 2 particles at 1000 J/kg, 2 % RT, 1 in Fig. 15)
@@ -53,7 +57,7 @@ from yadebreak.jobs.lifecycle import progress, tool_run
 from yadebreak.options.engine_flags import Derived, Override, attach_options, engine_flag
 from yadebreak.options.flags import (integer, jobs_option, numbers, out_option, overwrite_option,
                                      text)
-from yadebreak.studies.verify import fragmentation, probability
+from yadebreak.studies.verify import energy_audit, fragmentation, probability
 from yadebreak.studies.verify.report import write_report
 from yadebreak.studies.verify.settings import (PAPER_MATERIALS, Runner, paper_material, plan,  # noqa: F401
                        probability_energies)
@@ -65,7 +69,7 @@ FIGURES = {"probability": probability.figure_probability,
            "progeny": fragmentation.figure_progeny,
            "drop_weight": fragmentation.figure_drop_weight, "t10": fragmentation.figure_t10,
            "time_step": fragmentation.figure_time_step, "cs": fragmentation.figure_cs,
-           "damping": fragmentation.figure_damping}
+           "damping": fragmentation.figure_damping, "energy": energy_audit.figure_energy}
 
 #: the figures run unless --figures says otherwise: all
 DEFAULT_FIGURES = list(FIGURES)
