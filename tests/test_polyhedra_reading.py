@@ -165,7 +165,7 @@ def test_cells_under_the_minimum_volume_fraction_go_to_the_ledger():
     """The same forced breakage (t10' 25 %) with min_volume_fraction 0 and 1: with 1, every
     cell left in the scene has at least the cube of the event's smallest resolved size
     (X_MIN x 20 mm), the others' mass is in the ledger, and the mass is the parent's either
-    way; 0.25 (the default) removed none of 1,435 cells of 60 breakages (the smallest
+    way; 0.25 (the default) removed none of 1,460 cells of 60 breakages (the smallest
     resolved cell had 0.37 of that cube)."""
     from yade import O
     from yadebreak import model
