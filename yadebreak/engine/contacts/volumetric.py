@@ -1,5 +1,6 @@
-"""Reading a contact of YADE's volumetric law for convex polyhedra (Law2_PolyhedraGeom_PolyhedraPhys_Volumetric:
-a normal force kn V, V the volume the two bodies share, no dashpot).
+"""Reading a contact of YADE's volumetric law for convex polyhedra
+(Law2_PolyhedraGeom_PolyhedraPhys_Volumetric: a normal force kn V, V the volume the two bodies
+share, no dashpot).
 
 PolyhedraGeom gives no approach to integrate the force over (docs/polyhedra.md), so the approach
 is taken from the bodies' motion: over a read, the normal approach of the two material points at
