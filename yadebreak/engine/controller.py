@@ -93,7 +93,8 @@ class Controller:
         self.replacer = Replacer(config.replacement, self.state,
                                  self._recipes(scene_materials), self.zeroing, self.reader)
         rules = Rules(config.criteria.fragments_energy_factor, config.reading.fast_tolerance,
-                      config.criteria.break_at == "peak", any(self.pause_steps.values()))
+                      config.criteria.break_at == "peak", any(self.pause_steps.values()),
+                      config.replacement.contact_energy_at_break == "carried")
         self.judge = Judge(self.state, self._criterion_of, self.reader, rules,
                            record=self._record, warn_jump=self._warn_jump,
                            weakened=self.tracking.weakened)

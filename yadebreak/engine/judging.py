@@ -58,6 +58,7 @@ class Rules:
     fast_tolerance: float           # read_period="fast": see steps_allowed
     at_peak: bool = False           # break_at="peak"
     pausing: bool = False           # some material pauses fresh fragments
+    carried: bool = False           # contact_energy_at_break="carried"
 
 
 def _ignore(*args, **fields):
@@ -77,6 +78,7 @@ class Judge:
         self.at_peak = rules.at_peak
         self.energy_factor = rules.energy_factor
         self.pausing = rules.pausing
+        self.carried = rules.carried
         self.fast_tolerance = rules.fast_tolerance
         self.record, self.warn_jump, self.weakened = record, warn_jump, weakened
         #: up to this many candidates a read is judged body by body (plan_each)
@@ -115,7 +117,10 @@ class Judge:
                 need[k] = PAUSE
                 c["event_max"][i] = c["specific_energy"][i] = 0.0
                 continue
-            e, specific = self._specific(i, energy.get(i, 0.0), c)
+            e = energy.get(i, 0.0)
+            if self.carried:
+                e += c["carried"][i]
+            e, specific = self._specific(i, e, c)
             crit = self.criterion_of[c["material"][i]]
             breaks, level, threshold, rising, rise, jump = crit.judge_one(c, i, e, specific)
             if fast and rising:
@@ -149,6 +154,8 @@ class Judge:
                   else np.zeros(n, bool))
         active = known & ~paused
         ek = np.fromiter(map(loading.energy.get, candidates, repeat(0.0, n)), float, n)
+        if self.carried:
+            ek = ek + c["carried"][ids]
         if self.energy_factor != 1.0:
             ek = np.where(c["generation"][ids] > 0, ek * self.energy_factor, ek)
         specific = ek / c["mass"][ids]
@@ -207,6 +214,7 @@ class Judge:
                 # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
                 # did meanwhile is never counted later
                 self.reader.restart(i)
+                self.state.table.columns["carried"][i] = 0.0
                 open_events.discard(i)
             else:
                 open_events.discard(i)
@@ -223,7 +231,7 @@ class Judge:
         if fields is not None:
             self.record(criterion.event_kind, bid, specific_energy=event_max / mass,
                         partner=int(c["event_partner"][bid]), **fields)
-        c["event_max"][bid] = c["specific_energy"][bid] = 0.0
+        c["event_max"][bid] = c["specific_energy"][bid] = c["carried"][bid] = 0.0
         self.state.open_events.discard(bid)
         self.reader.restart(bid)
         if fields is not None:

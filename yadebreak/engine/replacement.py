@@ -46,9 +46,10 @@ def _elastic_energy(inter, zeroed):
     return energy
 
 
-def _neighbours(bid, zeroing, reader=None):
+def _neighbours(bid, zeroing, reader=None, each=None):
     """The parent's neighbours (ids) and the elastic energy (J) of its contacts with them (on
-    the volumetric law, what the reader's rows hold)."""
+    the volumetric law, what the reader's rows hold); `each` (a dict), if given, receives the
+    energy of each neighbour's contact."""
     if reader is not None and reader.volumetric:
         found = [i.id2 if i.id1 == bid else i.id1 for i in O.interactions.withBody(bid)]
         return found, reader.held(bid)
@@ -56,7 +57,10 @@ def _neighbours(bid, zeroing, reader=None):
     for inter in O.interactions.withBody(bid):
         other = inter.id2 if inter.id1 == bid else inter.id1
         found.append(other)
-        energy += _elastic_energy(inter, zeroing.pairs.get((min(bid, other), max(bid, other))))
+        held = _elastic_energy(inter, zeroing.pairs.get((min(bid, other), max(bid, other))))
+        energy += held
+        if each is not None:
+            each[other] = held
     return found, energy
 
 
@@ -99,6 +103,7 @@ class Replacer:
 
     def __init__(self, options, state, recipes, zeroing, reader):
         self.options = options         # config.Replacement
+        self.state = state
         self.table = state.table
         self.rng = state.rng
         self.ledger = state.ledger
@@ -135,7 +140,9 @@ class Replacer:
                                                   float(body.state.inertia[0]), parent_spin)
         vel = placement.fragment_velocities(centers, masses, center, parent_vel, spin)
         material = body.material
-        neighbours, elastic_before = _neighbours(bid, self.zeroing)
+        carry = {} if self.options.contact_energy_at_break == "carried" else None
+        neighbours, elastic_before = _neighbours(bid, self.zeroing, each=carry)
+        parent_material = material.id
         kinetic_before = 0.5 * (mass * parent_vel @ parent_vel
                                 + float(body.state.inertia[0]) * parent_spin @ parent_spin)
         O.bodies.erase(bid)
@@ -159,8 +166,10 @@ class Replacer:
         ids = list(O.bodies.append(new))
         self.new_rows(ids, label, fam.is_dummy[keep], radii, masses, t10, 2.0 * radius,
                        int(self.table.columns["generation"][bid]) + 1, dmin)
-        held, elastic_after = (self._contacts(ids, centers, radii, neighbours) if ids
-                               else (np.zeros(0), 0.0))
+        held, elastic_after, pairs = (self._contacts(ids, centers, radii, neighbours) if ids
+                                      else (np.zeros(0), 0.0, []))
+        if carry is not None and ids:
+            carried = self._carry(ids, centers, radii, masses, pairs, carry, parent_material)
         self.zeroing.wake()
         # no fragment may leave faster than the parent's rigid field allows, |v| + 2 |w| R
         # (v + w x (c_i - c_cm) after the momentum shift), counting the energy its contacts can
@@ -172,6 +181,8 @@ class Replacer:
                  "elastic_energy_before": float(elastic_before),
                  "kinetic_energy_after": kinetic_after,
                  "elastic_energy_after": elastic_after}
+        if carry is not None:
+            audit["carried_energy"] = carried if ids else 0.0
         smallest = {}
         for r, k in zip(radii.tolist(), kinds):
             if k.id not in smallest or r < smallest[k.id][0]:
@@ -205,6 +216,48 @@ class Replacer:
             for name, value in extra.items():
                 c[name][ids[need]] = value
 
+    def _carry(self, ids, centers, radii, masses, pairs, held, parent_material):
+        """contact_energy_at_break="carried": the parent's share (Eq. 4) of the elastic energy
+        each of its contacts held (`held`: neighbour id -> J) is counted as Ek' already absorbed
+        by the fragments that take that contact over: those that now overlap the neighbour
+        (`pairs` of _contacts), in proportion to the Hertz energy of their overlaps, sqrt(R*)
+        overlap^2.5 (the same materials on both sides), or else the fragment nearest to it (a
+        sphere or a wall; the family sits inside the parent, so that a shallow contact has
+        none overlapping). Their event is open from now, and the next read judges them. No
+        force changes. Returns the energy carried (J)."""
+        c = self.table.columns
+        index = {i: k for k, i in enumerate(ids)}
+        weights = {}                          # neighbour -> [(fragment row, weight)]
+        for a, other, overlap, _ in pairs:
+            if other not in held:             # a pair of fragments
+                continue
+            k = index[a]
+            r = float(radii[k])
+            ob = O.bodies[other]
+            if isinstance(ob.shape, wrapper.Sphere):
+                r = r * ob.shape.radius / (r + ob.shape.radius)
+            weights.setdefault(other, []).append((k, np.sqrt(r) * overlap ** 2.5))
+        for other in held:
+            if other not in weights and held[other] > 0.0:
+                k = _nearest(O.bodies[other], centers, radii)
+                if k is not None:
+                    weights[other] = [(k, 1.0)]
+        stiffness = self.reader.stiffness
+        energy = np.zeros(len(ids))
+        for other, shares in weights.items():
+            partner = stiffness[O.bodies[other].material.id]
+            share = float(model.energy_partition(stiffness[parent_material], partner))
+            total = sum(w for _, w in shares)
+            for k, w in shares:
+                energy[k] += share * held[other] * w / total
+        got = np.flatnonzero(energy > 0.0)
+        for k in got.tolist():
+            i = ids[k]
+            c["carried"][i] = energy[k]
+            c["specific_energy"][i] = energy[k] / float(masses[k])   # no jump at the next read
+            self.state.open_events.add(i)
+        return float(energy.sum())
+
     def _contacts(self, ids, centers, radii, neighbours):
         """Make the fragments' contacts (with each other and with the parent's neighbours) and
         zero their artificial overlaps: every overlap of a fresh fragment is the zero of its
@@ -213,7 +266,8 @@ class Replacer:
         one fragment, often a fine one near the loaded point, and throw it many times faster than
         the impact. Every overlapping pair is inherited: the reader counts its work from now on.
         Returns the elastic energy (J) each fragment's contacts hold (0 when zeroed, but for
-        local_damping's released share) and the energy of all those contacts (J)."""
+        local_damping's released share), the energy of all those contacts (J) and the pairs
+        (fragment, other body, overlap (m), made through YADE's geometry)."""
         zeroed = self.options.zero_overlaps
         pairs = []
         ii, jj, overlap = placement.overlapping_pairs(centers, radii)
@@ -240,7 +294,7 @@ class Replacer:
         self.reader.inherit([(a, b) for a, b, _, _ in pairs])
         held, total = np.zeros(len(ids)), 0.0
         if zeroed and self.zeroing.local_damping == 0.0:
-            return held, total                   # nothing held: no need to look
+            return held, total, pairs            # nothing held: no need to look
         index = {i: k for k, i in enumerate(ids)}
         for a, b, _, _ in pairs:
             energy = _elastic_energy(O.interactions[a, b],
@@ -249,7 +303,22 @@ class Replacer:
             for i in (a, b):
                 if i in index:
                     held[index[i]] += energy
-        return held, total
+        return held, total, pairs
+
+
+def _nearest(body, centers, radii):
+    """The row of the fragment whose surface is nearest to `body` (a sphere or a wall; None for
+    other shapes or a body gone)."""
+    if body is None:
+        return None
+    if isinstance(body.shape, wrapper.Sphere):
+        gap = np.linalg.norm(centers - np.array(body.state.pos), axis=1) - body.shape.radius
+    elif isinstance(body.shape, wrapper.Wall):
+        axis = body.shape.axis
+        gap = np.abs(centers[:, axis] - body.state.pos[axis])
+    else:
+        return None
+    return int(np.argmin(gap - radii))
 
 
 def _overlap_with(fragment, other):

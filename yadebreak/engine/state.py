@@ -39,6 +39,7 @@ _COLUMNS = {
     "damage": (np.float64, 0.0),                         # 1 - E / E_initial (Ab-T10: e_cum / E)
     "specific_energy": (np.float64, 0.0),                # Ek'/m at the last read
     "event_max": (np.float64, 0.0),                      # largest Ek' of the open event (J)
+    "carried": (np.float64, 0.0),       # Ek' (J) a fragment took over from its parent's contacts
     "event_partner": (np.int64, -1),    # the body across the contact that brought most of it
     "cracked": (np.int8, 0),            # break_at="peak": passed its threshold, breaks at the peak
     "t10": (np.float64, math.nan),      # unbreakable: first would-be t10'; dummy: its event's

@@ -170,6 +170,14 @@ OPTIONS = (
          lo_open=True),
     _row("local_damping", "replacement", 0.0, "number", "-",
          "share of a fragment's artificial overlap released as real force", 0, 1),
+    _row("contact_energy_at_break", "replacement", "dropped", "choice", "-",
+         "the elastic energy a broken sphere's contacts hold at its breakage, which the zeroing "
+         "of its fragments' overlaps takes out of the contacts: 'dropped' (the paper's "
+         "zeroing); 'carried', counted as already absorbed by the fragments that take over each "
+         "contact, shared by the Hertz energy of their overlaps, until their stressing event "
+         "ends (the paper's Section 1: successive events 'if there is still energy remaining "
+         "in the contact after the primary breakage event'; no force changes)",
+         words=("dropped", "carried")),
     _row("zero_overlaps", "replacement", True, "boolean", "-",
          "zero the artificial overlaps of fresh fragments (False only to show what it prevents)"),
     _row("zeroing_tolerance", "replacement", 0.05, "number", "-",
@@ -235,6 +243,7 @@ class Replacement:
     dummies: str
     dummy_stiffness: float
     local_damping: float
+    contact_energy_at_break: str
     zero_overlaps: bool
     zeroing_tolerance: float
     overlap_factor: float | None

@@ -76,7 +76,8 @@ DEFAULT_FIGURES = list(FIGURES)
 
 #: attach() options the command exposes for the fragmentation figures (Figs. 13-19), beyond
 #: the paper's settings (studies.verify.settings.PAPER)
-FRAGMENTATION = ("read_period", "kappa_successive", "break_at", "t10_energy", "dummy_stiffness")
+FRAGMENTATION = ("read_period", "kappa_successive", "break_at", "t10_energy", "dummy_stiffness",
+                 "contact_energy_at_break")
 #: the command's defaults that differ from attach()'s
 OVERRIDES = {"time_step_fraction": Override(
     Derived("the paper's per figure: 5 % (Figs. 8-11), 2 % (13-16), 1 % (17-19)", token=0.0),

@@ -269,6 +269,9 @@ def settings_text(options, material_names, size, particles, seed, extra="", damp
                "largest energy)" if options.get("break_at") == "peak" else "")
             + ("; beyond the paper: t10' over E50b of the energy absorbed at the break "
                "(Rocky's e50b option)" if options.get("t10_energy") == "e50b" else "")
+            + ("; the elastic energy of a broken particle's contacts carried to the fragments "
+               "that take them over" if options.get("contact_energy_at_break") == "carried"
+               else "")
             + (f"; beyond the paper: dummy spheres {options['dummy_stiffness']:g} times as stiff"
                if options.get("dummy_stiffness", OPTION["dummy_stiffness"].default)
                != OPTION["dummy_stiffness"].default else "")
