@@ -148,16 +148,22 @@ def test_the_plan_holds_every_figure_s_first_runs_and_leaves_no_plot_open(tmp_pa
     without running anything: quick Figs. 13-19 come to five fragmentation runs at 1000 J/kg
     (2 % RT with the file's damping, 5 % RT, damping 0, cs 1; the drop weight), Figs. 8-10 to
     their probability
-    runs; Fig. 11 runs in this process and is not in it; no figure is left open."""
+    runs, the energy audit to one task; Fig. 11 runs in this process and is not in it; no figure
+    is left open."""
     from yadebreak.studies.verify.report import plt_module
-    from yadebreak.studies.verify.settings import plan
+    from yadebreak.studies.verify.settings import Task, plan
     from yadebreak.options.flags import ScriptParser, add_params, read_params
     parser = ScriptParser(prog="verify")
     add_params(parser, verify.PARAMS)
     args = read_params(parser.parse_args(["--quick", "1", "--out", str(tmp_path)]), verify.PARAMS)
     args.material_list, args.energy_list = ["copper_ore"], [1000.0]
     args.damping_list = [0.0, 0.1, 0.3]
-    runs = plan(list(verify.FIGURES[name] for name in verify.DEFAULT_FIGURES), args, tmp_path)
+    planned = plan(list(verify.FIGURES[name] for name in verify.DEFAULT_FIGURES), args, tmp_path)
+    tasks = [t for t in planned if isinstance(t, Task)]
+    runs = [r for r in planned if not isinstance(r, Task)]
+    # the energy audit's one particle (quick: copper ore at 1000 J/kg), queued with the rest
+    assert [(t.spec["material"], t.spec["energy"], t.spec["counts"]) for t in tasks] == [
+        ("copper_ore", 1000.0, [1])]
     keys = {run.key(e) for run in runs for e in run.energies}
     fragmentation = {k for k in keys if '0.029' in k}
     assert len(fragmentation) == 5 and sum('"drop_weight"' in k for k in fragmentation) == 1

@@ -16,7 +16,12 @@ The package by concern (docs/architecture.md):
 `import yadebreak` needs only numpy and scipy: `attach` and `save` import the engine (and YADE)
 on first use.
 """
+import os
 from importlib import import_module
+
+# YADE's OpenMP loops in one thread, as the `yade` launcher runs them, unless the user chose: set
+# before anything loads libgomp (pyplot does), which reads it once (yadebreak.adapter.yadepath)
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 from yadebreak.model.materials import (Material, MaterialError, available_materials,
                                        load_material, material_search_path)

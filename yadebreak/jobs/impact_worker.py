@@ -4,9 +4,11 @@
 
 takes scenes from POOL's queue until POOL/stop appears: for each, {"set": SET, "scene": k}, it
 runs scene k of SET/spec.json (scenes.run_scenes), its events to SET/k.jsonl, then its tally to
-SET/k.tally.json (the parent's sign that the scene is done). PACKAGE is the parent's yadebreak,
+SET/k.tally.json (the parent's sign that the scene is done); a spec with a "task"
+("module:function") calls function(spec, k) instead and writes what it returns there. PACKAGE is the parent's yadebreak,
 wherever it lives. Coupling layer: imports yade.
 """
+import importlib
 import json
 import os
 import signal
@@ -32,9 +34,13 @@ IDLE_S = 0.05
 def run_one(task):
     folder, k = Path(task["set"]), int(task["scene"])
     spec = json.loads((folder / "spec.json").read_text())
-    tally, _ = scenes.run_scenes(spec, [k], folder / f"{k}.jsonl")
+    if "task" in spec:
+        module, name = spec["task"].split(":")
+        done = getattr(importlib.import_module(module), name)(spec, k)
+    else:
+        done = scenes.run_scenes(spec, [k], folder / f"{k}.jsonl")[0].to_dict()
     tmp = folder / f"{k}.tally.tmp"
-    tmp.write_text(json.dumps(tally.to_dict()))
+    tmp.write_text(json.dumps(done))
     os.replace(tmp, folder / f"{k}.tally.json")
 
 

@@ -47,7 +47,9 @@ class ImpactPool:
         self.close()
 
     def submit(self, spec, event_log=None):
-        """Queue every scene of a single_impacts `spec`; returns the set to collect(). With an
+        """Queue every scene of a single_impacts `spec` (or of a task's: {"task":
+        "module:function", "counts": one entry per scene, ...}, each scene a call of
+        function(spec, k) in a worker); returns the set to collect(). With an
         `event_log`, the set's folder is `<log>.workers` (a failed run leaves its events there)."""
         self._start()
         if event_log is None:
@@ -67,12 +69,15 @@ class ImpactPool:
         return ImpactSet(folder, spec, event_log)
 
     def collect(self, impact_set, on_scene=None, on_wait=None, wait_every_s=60.0):
-        """Wait for a set's scenes: (reports.ImpactTally of them all, merged in scene order).
-        on_scene(scenes done, scenes, tally so far) as they end; on_wait(scenes started, scenes
-        submitted), both counted over every set, every `wait_every_s` of waiting. A failed worker
-        stops the pool and raises with its last words."""
+        """Wait for a set's scenes: (reports.ImpactTally of them all, merged in scene order; of a
+        task's spec, what each scene's call returned, in scene order). on_scene(scenes done,
+        scenes, tally so far) as they end; on_wait(scenes started, scenes submitted), both
+        counted over every set, every `wait_every_s` of waiting. A failed worker stops the pool
+        and raises with its last words."""
         from yadebreak.analysis.reports import ImpactTally
         n = len(impact_set.spec["counts"])
+        task = "task" in impact_set.spec
+        read = (lambda data: data) if task else ImpactTally.from_dict
         tallies, reported = {}, 0
         told = time.time()
         while True:
@@ -83,8 +88,8 @@ class ImpactPool:
             for k in range(n):
                 path = impact_set.folder / f"{k}.tally.json"
                 if k not in tallies and path.exists():
-                    tallies[k] = ImpactTally.from_dict(json.loads(path.read_text()))
-            if on_scene is not None and len(tallies) > reported:
+                    tallies[k] = read(json.loads(path.read_text()))
+            if on_scene is not None and not task and len(tallies) > reported:
                 reported = len(tallies)
                 on_scene(reported, n, _merged(impact_set.spec["size"], tallies))
             if len(tallies) == n:
@@ -94,6 +99,8 @@ class ImpactPool:
             lines = "".join((impact_set.folder / f"{k}.jsonl").read_text() for k in range(n))
             Path(impact_set.event_log).write_text(lines)
         shutil.rmtree(impact_set.folder)
+        if task:
+            return [tallies[k] for k in range(n)]
         return _merged(impact_set.spec["size"], tallies)
 
     def close(self, keep=False):

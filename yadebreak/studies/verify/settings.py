@@ -76,6 +76,22 @@ def paper_options(time_step, **more):
             **{k: OPTION[k].default for k in PAPER_DEFAULTS}, **more}
 
 
+@dataclasses.dataclass(frozen=True)
+class Task:
+    """Scenes that are calls, not impacts: scene k is function(spec, k) for spec["task"] =
+    "module:function" and len(spec["counts"]) scenes, in a pool's worker or here. `cost` orders
+    the queue with the impacts' (_cost)."""
+
+    key: str
+    spec: dict
+    cost: float
+
+    def call(self, k):
+        import importlib
+        module, name = self.spec["task"].split(":")
+        return getattr(importlib.import_module(module), name)(self.spec, k)
+
+
 class Runner:
     """Runs impacts once per key (figures share runs) and keeps every result. With jobs > 1 the
     single-impact scenes go to one pool of YADE workers kept for the whole command
@@ -86,6 +102,7 @@ class Runner:
     def __init__(self, jobs):
         self.jobs = jobs
         self.results = {}
+        self.returned = {}                     # Task key -> what its scenes returned
         self._pool = None
         self._queued = {}                      # run key -> its scenes in the pool
 
@@ -105,14 +122,33 @@ class Runner:
                                                            on_wait=_waiting(run, energy)))
         return [[self.results[run.key(energy)] for energy in run.energies] for run in runs]
 
+    def run_tasks(self, tasks):
+        """What each Task's scenes returned (a list per task, in scene order; kept apart from
+        `results`, which the figure fills with what it makes of them)."""
+        self.queue(tasks)
+        for task in tasks:
+            if task.key in self.returned:
+                continue
+            if task.key in self._queued:
+                self.returned[task.key] = self._pool.collect(self._queued.pop(task.key))
+            else:
+                self.returned[task.key] = [task.call(k) for k in range(len(task.spec["counts"]))]
+        return [self.returned[task.key] for task in tasks]
+
     def queue(self, runs):
-        """Send the scenes of `runs` to the pool now (with jobs > 1), the costliest first."""
+        """Send the scenes of `runs` (Runs and Tasks) to the pool now (with jobs > 1), the
+        costliest first."""
         if self.jobs <= 1:
             return
-        todo = [(key, run, energy) for key, (run, energy) in _each(runs).items()
-                if key not in self.results and key not in self._queued]
-        for key, run, energy in sorted(todo, key=lambda item: -_cost(*item[1:])):
-            self._queued[key] = self._pool_of().submit(_spec(run, energy))
+        tasks = [t for t in runs if isinstance(t, Task)]
+        todo = [(key, _cost(run, energy), (run, energy))
+                for key, (run, energy) in _each([r for r in runs if not isinstance(r, Task)]).items()]
+        todo += [(t.key, t.cost, t) for t in tasks]
+        for key, _, what in sorted(todo, key=lambda item: -item[1]):
+            if key in self.results or key in self.returned or key in self._queued:
+                continue
+            spec = what.spec if isinstance(what, Task) else _spec(*what)
+            self._queued[key] = self._pool_of().submit(spec)
 
     def close(self):
         if self._pool is not None:
@@ -162,6 +198,10 @@ class Planner:
 
     def run_all(self, runs):
         self.runs += runs
+        raise Planner.Asked
+
+    def run_tasks(self, tasks):
+        self.runs += tasks
         raise Planner.Asked
 
     @property
