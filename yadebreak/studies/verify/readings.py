@@ -147,6 +147,39 @@ def table(out, readings):
     return lines, pooled
 
 
+def wide(pooled, readings):
+    """One row per point, one column per reading: t10 ± s.e. (t10 / Eq. 7; the passing's worst
+    departure from Eq. 10 at the sieves where it passes more than SIEVE_FLOOR %), target cases
+    marked met or not."""
+    points = {}
+    for reading in readings:
+        for p in pooled.get(reading, []):
+            points.setdefault((p["material"], p["energy"]), {})[reading] = p
+    lines = ["| material, Ek/mp (J/kg) | Eq. 7 (%) | particles | "
+             + " | ".join(readings) + " |", "|---" * (3 + len(readings)) + "|"]
+    for (material, energy), by in sorted(points.items()):
+        first = next(iter(by.values()))
+        cells = []
+        for reading in readings:
+            p = by.get(reading)
+            if p is None or p["t10"] is None:
+                cells.append("-")
+                continue
+            se = f" ± {p['t10_se']:.2f}" if p["t10_se"] else ""
+            worst = max(((sim / model - 1.0) for sim, model in
+                         zip(p["passing"], p["passing_model"]) if model > SIEVE_FLOOR), key=abs)
+            verdict = p["target"]
+            mark = ("" if verdict is None else " **met**" if verdict["t10_met"]
+                    and verdict["passing_met"] else " t10 met" if verdict["t10_met"] else "")
+            cells.append(f"{p['t10']:.2f}{se} ({p['t10'] / p['t10_model']:.2f}; "
+                         f"{100 * worst:+.0f} %){mark}")
+        target = "" if first["target"] is not None else " (no target)"
+        lines.append(f"| {material.replace('_', ' ')}, {energy:g}{target} | "
+                     f"{first['t10_model']:.2f} | {first['particles']} | " + " | ".join(cells)
+                     + " |")
+    return lines
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python3 -m yadebreak.studies.verify.readings",
                                      description=__doc__.split("\n")[0])
@@ -168,6 +201,7 @@ def main(argv=None):
         seeds = [int(s) for s in args.seeds.split(",")]
         run_all(args.out, readings, seeds, [(CASES[0][0], args.energies)], args.jobs)
     lines, pooled = table(args.out, readings)
+    lines = wide(pooled, readings) + [""] + lines
     Path(args.out).mkdir(parents=True, exist_ok=True)
     Path(args.out, "readings.md").write_text("\n".join(lines) + "\n")
     Path(args.out, "readings.json").write_text(json.dumps(
