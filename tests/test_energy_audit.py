@@ -16,14 +16,9 @@ SPEED = 45.0
 
 
 def _mechanical_energy(brk):
-    from yadebreak.adapter.yade_api import O
-    from yadebreak.engine.replacement import _elastic_energy
-    kinetic = sum(0.5 * b.state.mass * b.state.vel.squaredNorm()
-                  + 0.5 * b.state.inertia[0] * b.state.angVel.squaredNorm()
-                  for b in O.bodies if b is not None and b.dynamic)
-    elastic = sum(_elastic_energy(i, brk.zeroed.get((min(i.id1, i.id2), max(i.id1, i.id2))))
-                  for i in O.interactions if i.isReal)
-    return kinetic + elastic
+    from yadebreak.scenes.energy import energy_now
+    now = energy_now(brk)
+    return sum(now.kinetic.values()) + now.elastic
 
 
 def _run(duration, every=10, **options):

@@ -31,4 +31,5 @@ def test_the_target_reads_t10_and_every_sieve_where_eq10_passes_more_than_one_pe
     assert met["worst"] == pytest.approx(-0.19) and met["worst_size"] == 0.5
     short = readings.judge(readings.pool([_run(3, 8, 3.3, 0.1, (0.5, 5.0, 50.0))]))
     assert not short["t10_met"] and short["passing_met"]
-    assert readings.judge(readings.pool([_run(3, 8, 30.0, 1.0, (1, 5, 50), t10_model=25.0)])) is None
+    above = readings.pool([_run(3, 8, 30.0, 1.0, (1, 5, 50), t10_model=25.0)])
+    assert readings.judge(above) is None

@@ -29,7 +29,8 @@ or goes and the counts change (bed_auto: 57 events on the recording machine, 60 
     times the square root of the baseline's count, its counting noise): a few runs can miss a
     jump that another CPU makes, and the largest jump measured of a quantity that was steady in
     the others was 13 % (MEASURED); a small count moves further (bed_default's
-    unbreakable_stressed events: 11-13 recorded, 16 on another machine). Text outcomes (end_reason) must be one of the recorded runs'.
+    unbreakable_stressed events: 11-13 recorded, 16 on another machine). Text outcomes
+    (end_reason) must be one of the recorded runs'.
 (d) Only on the machine that recorded the baseline: every event and the whole summary within 1e-9
     (`differences`), checked when YADEBREAK_EXACT_REGRESSION=1; spread.json names that machine.
 

@@ -31,7 +31,7 @@ class Progeny:
     audit: dict
 
 
-def _elastic_energy(inter, zeroed):
+def contact_elastic_energy(inter, zeroed):
     """Elastic energy (J) a Hertz-Mindlin contact holds: 0.4 kno0 (d - d0)^2.5 in the normal
     direction (Fn = kno0 (d - d0)^1.5, d0 its zeroed overlap, if any; none while the zeroing
     holds it slack, kno = 0) plus |Fs|^2 / (2 ks) of the elastic shear force (the law's
@@ -57,7 +57,8 @@ def _neighbours(bid, zeroing, reader=None, each=None):
     for inter in O.interactions.withBody(bid):
         other = inter.id2 if inter.id1 == bid else inter.id1
         found.append(other)
-        held = _elastic_energy(inter, zeroing.pairs.get((min(bid, other), max(bid, other))))
+        held = contact_elastic_energy(inter,
+                                      zeroing.pairs.get((min(bid, other), max(bid, other))))
         energy += held
         if each is not None:
             each[other] = held
@@ -142,7 +143,6 @@ class Replacer:
         material = body.material
         carry = {} if self.options.contact_energy_at_break == "carried" else None
         neighbours, elastic_before = _neighbours(bid, self.zeroing, each=carry)
-        parent_material = material.id
         kinetic_before = 0.5 * (mass * parent_vel @ parent_vel
                                 + float(body.state.inertia[0]) * parent_spin @ parent_spin)
         O.bodies.erase(bid)
@@ -168,8 +168,6 @@ class Replacer:
                        int(self.table.columns["generation"][bid]) + 1, dmin)
         held, elastic_after, pairs = (self._contacts(ids, centers, radii, neighbours) if ids
                                       else (np.zeros(0), 0.0, []))
-        if carry is not None and ids:
-            carried = self._carry(ids, centers, radii, masses, pairs, carry, parent_material)
         self.zeroing.wake()
         # no fragment may leave faster than the parent's rigid field allows, |v| + 2 |w| R
         # (v + w x (c_i - c_cm) after the momentum shift), counting the energy its contacts can
@@ -182,7 +180,8 @@ class Replacer:
                  "kinetic_energy_after": kinetic_after,
                  "elastic_energy_after": elastic_after}
         if carry is not None:
-            audit["carried_energy"] = carried if ids else 0.0
+            audit["carried_energy"] = (self._carry(ids, centers, radii, masses, pairs, carry,
+                                                   material.id) if ids else 0.0)
         smallest = {}
         for r, k in zip(radii.tolist(), kinds):
             if k.id not in smallest or r < smallest[k.id][0]:
@@ -297,7 +296,7 @@ class Replacer:
             return held, total, pairs            # nothing held: no need to look
         index = {i: k for k, i in enumerate(ids)}
         for a, b, _, _ in pairs:
-            energy = _elastic_energy(O.interactions[a, b],
+            energy = contact_elastic_energy(O.interactions[a, b],
                                      self.zeroing.pairs.get((min(a, b), max(a, b))))
             total += energy
             for i in (a, b):

@@ -5,8 +5,8 @@
 takes scenes from POOL's queue until POOL/stop appears: for each, {"set": SET, "scene": k}, it
 runs scene k of SET/spec.json (scenes.run_scenes), its events to SET/k.jsonl, then its tally to
 SET/k.tally.json (the parent's sign that the scene is done); a spec with a "task"
-("module:function") calls function(spec, k) instead and writes what it returns there. PACKAGE is the parent's yadebreak,
-wherever it lives. Coupling layer: imports yade.
+("module:function") calls function(spec, k) instead and writes what it returns there.
+PACKAGE is the parent's yadebreak, wherever it lives. Coupling layer: imports yade.
 """
 import importlib
 import json

@@ -7,7 +7,7 @@ from typing import NamedTuple
 
 from yadebreak.adapter.yade_api import O
 from yadebreak.engine.parts.protocol import Part, install
-from yadebreak.engine.replacement import _elastic_energy
+from yadebreak.engine.replacement import contact_elastic_energy
 
 
 class EnergyNow(NamedTuple):
@@ -16,8 +16,8 @@ class EnergyNow(NamedTuple):
     body the engine does not track), the elastic energy its contacts hold (the engine's count,
     zeroed overlaps as the zero of their contacts), and what has been lost since
     track_energy(): the normal and shear dashpots and friction slip (ContactDissipation), and
-    from YADE's O.energy: Newton's damping (O.energy 'nonviscDamp': the engine's global damping of fragments) and
-    gravity's (O.energy 'gravWork', counted as YADE does: the energy total stays constant); the
+    from YADE's O.energy: Newton's damping ('nonviscDamp': the engine's global damping of
+    fragments) and gravity's (O.energy 'gravWork', counted as YADE does: the energy total stays constant); the
     kinetic energy the fines ledger carries (dummies="ledger")."""
 
     kinetic: dict
@@ -38,8 +38,8 @@ class ContactDissipation(Part):
     read once Newton has moved the bodies: the force (the law's, elastic and viscous) times the
     displacement of the two bodies' material points at the contact point (velocities v + w x r,
     averaged over the step, as the leapfrog's kinetic energy changes). The viscous part
-    (shearForce less shearElastic) is the shear dashpot; friction slip is the elastic part's work less the rise of its elastic energy
-    |Fs|^2 / (2 ks), plus that energy where a pair separates (a pair lost to a breakage is in
+    (shearForce less shearElastic) is the shear dashpot; friction slip is the elastic part's
+    work less the rise of its elastic energy |Fs|^2 / (2 ks), plus that energy where a pair separates (a pair lost to a breakage is in
     the breakage's elastic_energy_before). ScGeom's shearInc is not that displacement where the
     overlap is deep (a fragment's zeroed one): counted with it, friction ran 1.2 % of E0 over
     400 steps of a granulite cloud above the work the forces did. A contact of a body replaced
@@ -50,7 +50,7 @@ class ContactDissipation(Part):
     def __init__(self, label="energy_audit", period=1):
         super().__init__(label, period)
         self.normal = self.shear = self.friction = 0.0
-        self._last = {}                 # (id1, id2) -> (overlap, elastic shear force, energy)
+        self._last = {}                 # (id1, id2) -> (overlap, elastic shear energy)
         self._pending = []              # the last read's shear forces, their work still to count
         self._moved = {}                # body id -> (position, velocity, spin) at the last read
 
@@ -92,10 +92,10 @@ class ContactDissipation(Part):
             force = phys.shearElastic
             energy = 0.5 * force.squaredNorm() / phys.ks if phys.ks > 0.0 else 0.0
             before = last.get(key)
-            d0, e0 = (before[0], before[2]) if before is not None else (max(d, 0.0), 0.0)
+            d0, e0 = before if before is not None else (max(d, 0.0), 0.0)
             normal += abs(phys.normalViscous.dot(geom.normal)) * abs(d - d0)
             energy_rise += energy - e0
-            now[key] = (d, force, energy)
+            now[key] = (d, energy)
             # the viscous force the law applied: shearForce less its elastic part (YADE keeps
             # shearViscous with the opposite sign)
             pending.append((i.id1, i.id2, geom.contactPoint, phys.shearForce - force, force))
@@ -104,7 +104,7 @@ class ContactDissipation(Part):
                     s = bodies[j].state
                     moved[j] = (s.pos, s.vel, s.angVel)
         friction = work - energy_rise
-        for key, (_, _, e0) in last.items():
+        for key, (_, e0) in last.items():
             if key not in now and O.bodies[key[0]] is not None and O.bodies[key[1]] is not None:
                 friction += e0              # separated holding shear energy
         self._last, self._pending, self._moved = now, pending, moved
@@ -138,7 +138,8 @@ def energy_now(brk, part=None):
                         + b.state.inertia[0] * b.state.angVel.squaredNorm())
         kinetic[kind] = kinetic.get(kind, 0.0) + energy
     zeroed = brk.zeroed
-    elastic = sum(_elastic_energy(i, zeroed.get((min(i.id1, i.id2), max(i.id1, i.id2))))
+    elastic = sum(contact_elastic_energy(i, zeroed.get((min(i.id1, i.id2),
+                                                        max(i.id1, i.id2))))
                   for i in O.interactions if i.isReal)
     totals = dict(O.energy.items())
     normal, shear, friction = ((part.normal, part.shear, part.friction) if part is not None

@@ -100,7 +100,8 @@ class ContactReader:
         return total
 
     def held(self, body):
-        """Elastic energy (J) a body's volumetric contacts hold, both sides (contacts/volumetric)."""
+        """Elastic energy (J) a body's volumetric contacts hold, both sides
+        (contacts/volumetric)."""
         return held_total(self.table, body)
 
     def _stored_share_block(self, sides):

@@ -187,20 +187,20 @@ def _paper_options(args, time_step):
 
 #: an audited scene costs about this many of the same impact's scenes run as Fig. 16 runs them
 #: (every contact read every step; measured: granulite at 1000 J/kg, 75 s against 21 s): the
-#: place of its task in the pool's queue (settings._cost)
+#: place of its task in the pool's queue (settings.run_cost)
 AUDIT_COST = 3.5
 
 
 def audit_task(name, energy, particles, seed, options):
     """The Task of `particles` particles of material `name` at `energy` (J/kg): scene k is
     particle k (audit_scene), in a pool's worker or here."""
-    from yadebreak.studies.verify.settings import Run, Task, _cost
+    from yadebreak.studies.verify.settings import Run, Task, run_cost
     options = {**options, "global_damping": paper_material(name).global_damping}
     key = json.dumps(["energy_audit", name, energy, particles, seed, sorted(options.items())])
     spec = {"task": f"{__name__}:audit_scene", "counts": [1] * particles, "material": name,
             "size": FRAGMENT_SIZE, "energy": energy, "seed": seed, "options": options}
     like = Run(name, FRAGMENT_SIZE, [energy], particles, seed, options)
-    return Task(key, spec, AUDIT_COST * _cost(like, energy))
+    return Task(key, spec, AUDIT_COST * run_cost(like, energy))
 
 
 def audit_scene(spec, k):

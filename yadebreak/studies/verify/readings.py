@@ -99,6 +99,18 @@ def pool(runs):
     return point
 
 
+def worst_sieve(point):
+    """(the passing's largest relative departure from Eq. 10's, its relative size) over the
+    sieves where Eq. 10 passes more than SIEVE_FLOOR %."""
+    worst, at = 0.0, None
+    for size, sim, model in zip(point["sizes"], point["passing"], point["passing_model"]):
+        if model > SIEVE_FLOOR:
+            off = sim / model - 1.0
+            if abs(off) > abs(worst):
+                worst, at = off, size
+    return worst, at
+
+
 def judge(point):
     """The target at one point: None where Eq. 7 is above the ceiling (not a target case), else
     (t10 met, passing met, worst passing ratio and its relative size)."""
@@ -107,12 +119,7 @@ def judge(point):
     if point["t10"] is None:
         return {"t10_met": False, "passing_met": False, "worst": None, "worst_size": None}
     t10_met = abs(point["t10"] / point["t10_model"] - 1.0) <= T10_TOLERANCE
-    worst, at = 0.0, None
-    for size, sim, model in zip(point["sizes"], point["passing"], point["passing_model"]):
-        if model > SIEVE_FLOOR:
-            off = sim / model - 1.0
-            if abs(off) > abs(worst):
-                worst, at = off, size
+    worst, at = worst_sieve(point)
     return {"t10_met": t10_met, "passing_met": abs(worst) <= PASSING_TOLERANCE, "worst": worst,
             "worst_size": at}
 
@@ -166,8 +173,7 @@ def wide(pooled, readings):
                 cells.append("-")
                 continue
             se = f" ± {p['t10_se']:.2f}" if p["t10_se"] else ""
-            worst = max(((sim / model - 1.0) for sim, model in
-                         zip(p["passing"], p["passing_model"]) if model > SIEVE_FLOOR), key=abs)
+            worst, _ = worst_sieve(p)
             verdict = p["target"]
             mark = ("" if verdict is None else " **met**" if verdict["t10_met"]
                     and verdict["passing_met"] else " t10 met" if verdict["t10_met"] else "")

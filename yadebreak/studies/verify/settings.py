@@ -80,7 +80,7 @@ def paper_options(time_step, **more):
 class Task:
     """Scenes that are calls, not impacts: scene k is function(spec, k) for spec["task"] =
     "module:function" and len(spec["counts"]) scenes, in a pool's worker or here. `cost` orders
-    the queue with the impacts' (_cost)."""
+    the queue with the impacts' (run_cost)."""
 
     key: str
     spec: dict
@@ -140,10 +140,10 @@ class Runner:
         costliest first."""
         if self.jobs <= 1:
             return
-        tasks = [t for t in runs if isinstance(t, Task)]
-        todo = [(key, _cost(run, energy), (run, energy))
-                for key, (run, energy) in _each([r for r in runs if not isinstance(r, Task)]).items()]
-        todo += [(t.key, t.cost, t) for t in tasks]
+        impacts = [r for r in runs if not isinstance(r, Task)]
+        todo = [(key, run_cost(run, energy), (run, energy))
+                for key, (run, energy) in _each(impacts).items()]
+        todo += [(t.key, t.cost, t) for t in runs if isinstance(t, Task)]
         for key, _, what in sorted(todo, key=lambda item: -item[1]):
             if key in self.results or key in self.returned or key in self._queued:
                 continue
@@ -227,7 +227,7 @@ def _each(runs):
     return {run.key(energy): (run, energy) for run in runs for energy in run.energies}
 
 
-def _cost(run, energy):
+def run_cost(run, energy):
     """A guess of a run's cost, to start the longest first: breakage cascades grow with the
     energy, the steps with 1 / time step, the shear share adds breakage. Probability runs
     (nothing replaced) take seconds: they go first, so that their figures come in minutes."""
