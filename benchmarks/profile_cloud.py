@@ -4,12 +4,13 @@ updates, judging, replacement, the time step and the event log (cProfile, cumula
 
     /usr/bin/python3 benchmarks/profile_cloud.py [--case copper|iron] [--material M] [--size m]
         [--energy J/kg] [--particles 1] [--fraction 0.02] [--steps 0] [--top 0]
-        [--plain]
+        [--plain] [--floor]
 
 `--case copper` (the default): the 29 mm copper ore at 3000 J/kg of verify's cascade; `--case
 iron`: the 10 mm iron_ore_1 at 1000 J/kg of `scripts/single_impact.py`'s top energy (the
 explicit options override the case's). `--top N` lists the N functions of most own time.
 cProfile slows yadebreak's Python (not YADE's engines): `--plain` runs without it, for the ratio.
+`--floor` adds what every-step reading cannot avoid through YADE's Python interface (Floor).
 
 One scene of `--particles` particles fired at a steel plate at `--energy` J/kg, contacts read
 every step at `--fraction` of the Rayleigh time (verify's fragmentation settings), run until the
@@ -54,6 +55,9 @@ def main():
     parser.add_argument("--steps", type=int, default=0, help="0: until the fragments are done")
     parser.add_argument("--top", type=int, default=0, help="list the N functions of most own time")
     parser.add_argument("--plain", action="store_true", help="no cProfile: the ratio only")
+    parser.add_argument("--floor", action="store_true",
+                        help="also the floor: what YADE's Python interface costs per step for "
+                             "what every-step reading must touch (see Floor)")
     a = parser.parse_args(sys.argv[1:])
     case = CASES[a.case]
     a.material = a.material or case[0]
@@ -67,10 +71,11 @@ def main():
     start, first = time.perf_counter(), O.iter
     if not a.plain:
         profile.enable()
+    floor = Floor(brk) if a.floor else None
     if a.steps:
         engine.run_steps(a.steps)
     else:
-        scenes.run_until_rebound(ids, brk=brk)
+        scenes.run_until_rebound(ids, brk=brk, on_check=floor and floor.sample)
     profile.disable()
     wall = time.perf_counter() - start
     steps = O.iter - first
@@ -92,8 +97,79 @@ def main():
                     if name in names and path.endswith(where))
         print(f"  {label:24s}  {per * total:8.3f} ms")
     print(f"  whole step / YADE alone   {per * wall / yade_alone:8.2f} x")
+    if floor is not None:
+        floor.report(yade_alone)
     if a.top and not a.plain:
         pstats.Stats(profile).sort_stats("tottime").print_stats(a.top)
+
+
+class Floor:
+    """What every-step reading cannot avoid through YADE's Python interface, per step: YADE's
+    count of each body's interactions (how new contacts are found: one C++ call, timed at each
+    check of the run), a visit of each zeroed pair awake (its two positions, their distance, its
+    two stiffnesses written) and a read of each contact row awake (its overlap and normal
+    force), these two at their unit costs timed at the end of the run; the counts of pairs and
+    rows awake sampled at each check (every 50 steps). The two PyRunner calls a step makes (a
+    few us each) are left out."""
+
+    def __init__(self, brk):
+        self.brk = brk
+        self.samples = []                 # (counts s, pairs awake, rows awake)
+
+    def sample(self):
+        from yadebreak.adapter.yade_api import utils
+        table = self.brk.reader.table
+        resting = 0 if table.resting is None else int(table.resting.sum())
+        counts = min(_timed(utils.numIntrsOfEachBody, 3))
+        self.samples.append((counts, len(self.brk.zeroing.awake), len(table) - resting))
+
+    def report(self, yade_ms):
+        s = np.array(self.samples)
+        pair, row = self._unit_costs()
+        counts, pairs, rows = s.mean(axis=0)
+        per_step = 1e3 * (counts + pairs * pair + rows * row)
+        print(f"  floor, per step (means of {len(s)} checks): counts {1e3 * counts:.3f} ms; "
+              f"{pairs:.0f} pairs awake x {1e6 * pair:.2f} us; {rows:.0f} rows awake x "
+              f"{1e6 * row:.2f} us")
+        print(f"  floor                     {per_step:8.3f} ms = {per_step / yade_ms:.2f} x YADE "
+              f"alone: whole step at best {1.0 + per_step / yade_ms:.2f} x")
+
+    def _unit_costs(self):
+        """Seconds per zeroed-pair visit and per row read, on the scene's objects now."""
+        from yadebreak.adapter.yade_api import wrapper
+        pairs = []
+        for a, b in list(self.brk.zeroing.pairs)[:300]:
+            ba, bb = O.bodies[a], O.bodies[b]
+            if (ba is None or bb is None or not O.interactions.has(a, b)
+                    or not all(isinstance(x.shape, wrapper.Sphere) for x in (ba, bb))):
+                continue
+            phys = O.interactions[a, b].phys
+            pairs.append((ba.state, bb.state, phys, phys.kno, phys.kso))
+
+        def visit():
+            for sa, sb, phys, kno, kso in pairs:
+                (sa.pos - sb.pos).norm()
+                phys.kno = kno                    # the same values: nothing changes
+                phys.kso = kso
+        table = self.brk.reader.table
+        rows = [(g, p) for g, p in zip(table.geoms, table.physs) if g is not None][:300]
+
+        def read():
+            for g, p in rows:
+                g.penetrationDepth
+                p.normalForce.norm()
+        pair = min(_timed(visit, 20)) / max(len(pairs), 1)
+        row = min(_timed(read, 20)) / max(len(rows), 1)
+        return pair, row
+
+
+def _timed(call, repeats):
+    out = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        call()
+        out.append(time.perf_counter() - t)
+    return out
 
 
 if __name__ == "__main__":

@@ -3,7 +3,9 @@ interactions, for a few contacts; numpy over the rows kept, with new contacts lo
 around the bodies whose count of interactions changed, for many) read the same scene alike: the
 same contacts with the same numbers bit for bit, the same energies (to round-off: the rows are
 summed in another order), strongest contacts and growing bodies, through impacts, breakage,
-zeroed and sleeping pairs and inherited contacts, with and without shear work. The physics both
+zeroed and sleeping pairs and inherited contacts, with and without shear work; and the numpy
+path reads alike whether it looks every row up in the zeroed and sleeping pairs or follows the
+pairs the zeroing changed, and tells what bodies' contacts hold alike for one body or many. The physics both
 call (HertzMindlinWork, own_share) is tested on closed forms in test_engine_parts.py."""
 import numpy as np
 import pytest
@@ -35,8 +37,12 @@ def test_both_paths_read_a_breaking_bed_alike(scene, cs):
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 3, 1, 6.0, seed=4, read_period=1,
                                         dummies="spheres", cs=cs)
     O = scene
-    each, full = (ContactReader(brk.reader.stiffness, cs, brk.reader.emin) for _ in range(2))
-    each.small, full.small = 10 ** 9, -1
+    each, full, kept = (ContactReader(brk.reader.stiffness, cs, brk.reader.emin)
+                        for _ in range(3))
+    each.small, full.small, kept.small = 10 ** 9, -1, -1
+    # `kept` is told the pairs the zeroing changed since its last read (ZeroedRows follows them),
+    # `full` looks every row up in the zeroed and asleep pairs at every read
+    zeroed_then, asleep_then, changes, held = set(), set(), 0, 0
     while not any(O.interactions.withBody(info["ball"])):
         engine.run_steps(50)
     scenes.hold_release(info)
@@ -44,7 +50,7 @@ def test_both_paths_read_a_breaking_bed_alike(scene, cs):
     seen = {"zeroed": 0, "asleep": 0, "inherited": 0}
     for step in range(4000):
         O.step()
-        for r in (each, full):            # what the engine told its reader since the last step
+        for r in (each, full, kept):      # what the engine told its reader since the last step
             r.inherited |= brk.reader.inherited
             r.erased_bodies |= brk.reader.erased_bodies
         for what, pairs in (("zeroed", brk.zeroing.pairs), ("asleep", brk.zeroing.asleep),
@@ -55,12 +61,23 @@ def test_both_paths_read_a_breaking_bed_alike(scene, cs):
         state = brk.state
         args = (O.interactions, O.bodies, state.tracked, brk.zeroing.pairs, O.time, 3,
                 brk.zeroing.asleep, utils.numIntrsOfEachBody)
-        _same_loading(each.read(*args), full.read(*args))
+        zeroed_now, asleep_now = set(brk.zeroing.pairs), set(brk.zeroing.asleep)
+        changed = (zeroed_now ^ zeroed_then) | (asleep_now ^ asleep_then)
+        zeroed_then, asleep_then = zeroed_now, asleep_now
+        by_full = full.read(*args)
+        _same_loading(each.read(*args), by_full)
         assert _rows(each) == _rows(full)
+        _same_loading(kept.read(*args, zeroing_changes=changed), by_full)
+        assert _rows(kept) == _rows(full)
+        changes += len(changed)
+        # what a body's contacts hold, asked for many bodies at once or body by body
+        asked = sorted(full.bodies_in_contact() & state.tracked)
+        assert full.stored_shares(asked) == [full.stored_share(i) for i in asked]
+        held += sum(x > 0.0 for x in full.stored_shares(asked))
         reads += 1
     assert brk.breakage_events, "the bed must break for the comparison to mean something"
     assert min(seen.values()) > 10, seen    # zeroed, sleeping and inherited pairs were read
-    assert len(full) > 0 and reads > 1000
+    assert len(full) > 0 and reads > 1000 and changes > 100 and held > 1000
 
 
 def test_many_contacts_saved_and_loaded_read_on_as_the_run_that_went_on(scene, tmp_path):

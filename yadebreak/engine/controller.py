@@ -209,6 +209,7 @@ class Controller:
         replace -> time step -> reschedule."""
         state = self.state
         if not state.tracked and not state.open_events:
+            self.zeroing.forget_changes()         # the next read looks every row up
             self.damping.release()
             self.last_iter = O.iter               # nothing can break: next to no cost
             return
@@ -216,7 +217,7 @@ class Controller:
         interval = max(1, O.iter - self.last_iter)        # steps since the last read
         loading = self.reader.read(O.interactions, O.bodies, state.tracked, self.zeroing.pairs,
                                    O.time, interval, self.zeroing.asleep,
-                                   utils.numIntrsOfEachBody)
+                                   utils.numIntrsOfEachBody, self.zeroing.take_changes())
         self.wall_time["read"] += time.perf_counter() - t0
         broken, limits = self.judge.judge(loading, interval, O.iter, self.schedule.mode == "fast")
         if self.large_overlaps is not None:

@@ -196,6 +196,7 @@ class Judge:
         visit = range(len(candidates))
         if any(plan.order):
             visit = sorted(visit, key=plan.order.__getitem__)      # stable
+        unloaded = self._unloaded(candidates, plan, loading)
         for k in visit:
             what = plan.need[k]
             if what == NOTHING:
@@ -204,7 +205,7 @@ class Judge:
             if what == OPEN:
                 open_events.add(i)
             elif what == CLOSE_IF_UNLOADED:
-                if i not in loading.grew and self.reader.stored_share(i) <= self.reader.emin:
+                if i in unloaded:
                     self.close_event(i)
             elif what == BREAK:
                 if plan.jump[k] > LATE_JUMP * plan.threshold[k]:
@@ -219,6 +220,17 @@ class Judge:
             else:
                 open_events.discard(i)
         return broken
+
+    def _unloaded(self, candidates, plan, loading):
+        """The bodies whose event may close that unloaded: none of their contacts worked and
+        their contacts hold at most emin (asked at once: closing one body's event restarts its
+        own offsets only, so the order does not matter)."""
+        asked = [i for i, what in zip(candidates, plan.need)
+                 if what == CLOSE_IF_UNLOADED and i not in loading.grew]
+        if not asked:
+            return ()
+        emin = self.reader.emin
+        return {i for i, held in zip(asked, self.reader.stored_shares(asked)) if held <= emin}
 
     def close_event(self, bid):
         """End of a stressing event without breakage: the criterion's damage rule (Eqs. 5-6 or

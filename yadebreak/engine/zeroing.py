@@ -52,6 +52,8 @@ class OverlapZeroing:
         self._wake_at = {}                       # step -> pairs that wake then
         self._cache = {}                         # pair -> YADE objects read every step
         self._loaded_depth = {}                  # wall, facet pair -> overlap (m) when saved
+        self._changes = set()                    # pairs zeroed, dropped, asleep or woken
+        #                                          since take_changes() (None: not kept)
 
     def __bool__(self):
         return bool(self.pairs)
@@ -71,6 +73,7 @@ class OverlapZeroing:
                        ZeroedOverlap((1.0 - self.local_damping) * artificial, ph.kno, ph.kso))
 
     def _register(self, key, zero):
+        self._changed(key)
         self.pairs[key] = zero
         self.awake.add(key)
         for i in key:
@@ -81,6 +84,7 @@ class OverlapZeroing:
             self._drop(key)
 
     def _drop(self, key):
+        self._changed(key)
         self.pairs.pop(key, None)
         self._cache.pop(key, None)
         self.awake.discard(key)
@@ -91,6 +95,20 @@ class OverlapZeroing:
                 pairs.discard(key)
                 if not pairs:
                     del self.by_body[i]
+
+    def take_changes(self):
+        """The pairs that were zeroed, dropped, fell asleep or woke since the last call (None:
+        not known, after forget_changes)."""
+        changes, self._changes = self._changes, set()
+        return changes
+
+    def forget_changes(self):
+        """Stop keeping the changes until the next take_changes (no one asks meanwhile)."""
+        self._changes = None
+
+    def _changed(self, key):
+        if self._changes is not None:
+            self._changes.add(key)
 
     def artificial(self, id_a, id_b):
         """The zeroed overlap (m) of a pair, 0 if none."""
@@ -161,6 +179,7 @@ class OverlapZeroing:
         for key in done:
             self._drop(key)
         for key, when in sleep:
+            self._changed(key)
             self.awake.discard(key)
             self.asleep.add(key)
             self._wake_at.setdefault(when, []).append(key)
@@ -172,6 +191,7 @@ class OverlapZeroing:
         for when in [w for w in self._wake_at if w <= now]:
             for key in self._wake_at.pop(when):
                 if key in self.asleep:
+                    self._changed(key)
                     self.asleep.discard(key)
                     self.awake.add(key)
                     woken = woken or set()

@@ -10,7 +10,9 @@ import numpy as np
 from yadebreak.engine.contacts.law import HertzMindlinWork, own_share, total_work
 from yadebreak.engine.contacts.loading import Loading, StrongestContacts
 from yadebreak.engine.contacts.table import (OVERLAP, OVERLAP_BEFORE, FORCE, SHEAR_DISP,
-                                             SHEAR_FORCE, TIME_BEFORE, TIME_READ, fresh_row)
+                                             SHEAR_FORCE, TIME_BEFORE, TIME_READ, fresh_row,
+                                             take)
+from yadebreak.engine.contacts.zeroed_rows import ZeroedRows
 
 _law = HertzMindlinWork
 
@@ -21,19 +23,31 @@ class ArrayRead:
     def __init__(self, reader):
         self.reader = reader
         self.table = reader.table
+        self.zeroed_rows = ZeroedRows()
 
-    def __call__(self, interactions, bodies, tracked, zeroed, now, interval, asleep, counts):
+    def __call__(self, interactions, bodies, tracked, zeroed, now, interval, asleep, counts,
+                 zeroing_changes=None):
         """One read; see ContactReader.read."""
         reader, table = self.reader, self.table
         mask = np.zeros(len(bodies), bool)              # tracked, by body id
         if tracked:
             mask[np.fromiter(tracked, np.int64, len(tracked))] = True
-        fresh, restored, delta = self._screen(interactions, bodies, mask, counts, now)
+        flags = None                                    # which rows are zeroed, asleep
+        if zeroed:
+            flags = self.zeroed_rows
+            if table.incomplete:
+                flags.forget()
+            else:
+                flags.update(table.pairs(), zeroed, asleep, zeroing_changes)
+        fresh, restored, delta = self._screen(interactions, bodies, mask, counts, now, flags,
+                                              zeroed, asleep)
         pairs = table.pairs() if (reader.inherited or asleep or zeroed) else None
-        in_zeroed = pairs.among(zeroed) if zeroed else None
+        in_zeroed = None
         update = None                          # every row
-        if asleep:                             # pairs asleep are zeroed pairs: look there only
-            update = ~(pairs.among(asleep, within=in_zeroed) & ~fresh & ~restored)
+        if flags is not None:
+            in_zeroed, resting = flags.update(pairs, zeroed, asleep, set())
+            if asleep:
+                update = ~(resting & ~fresh & ~restored)
         force, us, fs = self._forces(update)
         if reader.inherited and fresh.any():
             self._start_here(fresh & pairs.among(reader.inherited), delta, force, us, fs)
@@ -42,6 +56,7 @@ class ArrayRead:
         if us is not None:
             self._shear_work(us, fs, update)
         table.by_body = None
+        table.resting = None if update is None else ~update
         return self._loading(mask[table.a], mask[table.b], worked)
 
     def _forces(self, update):
@@ -51,8 +66,8 @@ class ArrayRead:
         (they are not updated), and reading them from YADE would cost a microsecond each; the
         fragment clouds of a cascade are mostly such pairs."""
         table = self.table
-        physs = table.physs if update is None else [table.physs[k]
-                                                    for k in np.flatnonzero(update).tolist()]
+        physs = table.physs if update is None else take(table.physs,
+                                                        np.flatnonzero(update).tolist())
         m = len(physs)
 
         def kept(got, stored):                 # the rows read, the others as they were
@@ -89,17 +104,31 @@ class ArrayRead:
         table.incomplete = False
         return restored[found]
 
-    def _screen(self, interactions, bodies, mask, counts, now):
+    def _screen(self, interactions, bodies, mask, counts, now, flags, zeroed, asleep):
         """The rows laid out as the contacts of tracked bodies now, without a pass over every
         interaction: a row whose overlap is negative was erased by the law at its last step (its
         geometry is YADE's last, kept alive by the row) and goes; rows with no tracked body go;
         then a tracked body whose count of real interactions (YADE's, in C++) differs from its
         rows has them taken from YADE (withBody): new ones become fresh rows, missing ones go.
-        Returns masks of the fresh rows and of rows restored from a save, and the overlaps."""
+        The rows of zeroed pairs asleep (`flags`, a ZeroedRows, or None) are not read: they are
+        slack, and nothing uses their overlap; one the law erased since is found missing by its
+        bodies' count. `flags` follows the rows (of the pairs `zeroed`, `asleep`).
+        Returns masks of the fresh rows and of rows restored from a save, and the overlaps (the
+        last read's for the rows asleep)."""
         table, erased = self.table, self.reader.erased_bodies
         restored = (self._find_restored(interactions, bodies) if table.incomplete
                     else np.zeros(len(table), bool))
-        delta = np.fromiter([g.penetrationDepth for g in table.geoms], float, len(table))
+        geoms = table.geoms
+        if flags is not None and flags.pairs is None:
+            flags = None                       # rows restored: looked up once the read is done
+        resting = None if flags is None or not asleep else flags.asleep
+        if resting is None:
+            delta = np.fromiter([g.penetrationDepth for g in geoms], float, len(table))
+        else:
+            delta = table.overlap.copy()
+            read = np.flatnonzero(~resting)
+            delta[read] = np.fromiter([g.penetrationDepth for g in take(geoms, read.tolist())],
+                                      float, len(read))
         keep = (delta >= 0.0) & (mask[table.a] | mask[table.b])
         if erased:
             gone = np.zeros(len(mask), bool)
@@ -109,20 +138,30 @@ class ArrayRead:
             rows = np.flatnonzero(keep)
             table.keep(rows)
             delta, restored = delta[rows], restored[rows]
+            if flags is not None:
+                flags.keep(rows)
         have = np.bincount(np.concatenate((table.a, table.b)), minlength=len(mask))
         changed = np.flatnonzero(mask & (have != np.asarray(counts(), np.int64)))
-        fresh = np.zeros(len(table), bool)
+        fresh = None
         if len(changed):
             kept, new = self._rescan(interactions, bodies, changed, now)
             if kept is not None:
                 delta, restored = delta[kept], restored[kept]
+                if flags is not None:
+                    flags.keep(kept)
             if new:
                 added = np.fromiter([inter.geom.penetrationDepth for inter in new], float,
                                     len(new))
-                fresh = np.concatenate((np.zeros(len(delta), bool), np.ones(len(new), bool)))
+                none = np.zeros(len(new), bool)
+                fresh = np.concatenate((np.zeros(len(delta), bool), ~none))
                 delta = np.concatenate((delta, added))
-                restored = np.concatenate((restored, np.zeros(len(new), bool)))
-        return fresh, restored, delta
+                restored = np.concatenate((restored, none))
+                if flags is not None:
+                    flags.append([(min(i.id1, i.id2), max(i.id1, i.id2)) for i in new], zeroed,
+                                 asleep)
+        if flags is not None:
+            flags.pairs = table.pairs()
+        return (np.zeros(len(table), bool) if fresh is None else fresh), restored, delta
 
     def _rescan(self, interactions, bodies, changed, now):
         """Rows of the bodies `changed` from YADE's own lists: rows not in them go, interactions

@@ -58,20 +58,23 @@ class ContactReader:
     def __len__(self):
         return len(self.table)
 
-    def read(self, interactions, bodies, tracked, zeroed, now, interval, asleep=(), counts=None):
+    def read(self, interactions, bodies, tracked, zeroed, now, interval, asleep=(), counts=None,
+             zeroing_changes=None):
         """One read of the real interactions; contacts that ceased drop out. `zeroed` holds the
         pairs whose kno varies, `asleep` those of them that carry no force and are not updated
         now (they do no work), all keyed (smaller id, larger id); `interval` is the steps since
         the last read; `counts()` gives the real interactions of each body id (YADE's
         numIntrsOfEachBody, in C++): with it, a read of many contacts looks for new ones only
-        around the bodies whose count changed."""
+        around the bodies whose count changed; `zeroing_changes`, the pairs that entered or left
+        `zeroed` or `asleep` since the last read (None: unknown), spares it looking every row up
+        in them again."""
         if self.volumetric or counts is None or len(self.table) <= self.small:
             loading = read_each(self, interactions.all(True), bodies, tracked, zeroed, now,
                                 interval, asleep,
                                 self.last_time if self.last_time is not None else now)
         else:
             loading = self._read_arrays(interactions, bodies, tracked, zeroed, now, interval,
-                                        asleep, counts)
+                                        asleep, counts, zeroing_changes)
         self.inherited.clear()                 # read now or gone
         self.erased_bodies.clear()
         self.last_time = now
@@ -98,6 +101,35 @@ class ContactReader:
                 share = value(row, SHARE_B if side else SHARE_A)
                 total += share * self.law.stored(table.physs[row].kno, overlap)
         return total
+
+    def stored_shares(self, bodies):
+        """stored_share of each of `bodies` (a list), at once: one numpy pass over the block's
+        rows for many bodies (an open event in a fragment cloud asks every read whether its body
+        unloaded), the same sums in the same order as stored_share body by body."""
+        table = self.table
+        if self.volumetric or not table.is_block or len(bodies) < 2:
+            return [self.stored_share(b) for b in bodies]
+        d = table.data
+        overlap, work = d[OVERLAP], total_work(d[WORK], d[SHEAR_WORK], self.cs)
+        pressed = overlap > 0.0
+        if table.resting is not None:
+            pressed &= ~table.resting   # asleep zeroed pairs: slack, kno 0, nothing held
+        slot = np.full(max(int(table.a.max(initial=0)), int(table.b.max(initial=0)),
+                           max(bodies)) + 1, -1, np.int64)
+        slot[bodies] = np.arange(len(bodies))     # body id -> its place in `bodies`
+        sides = []                      # (2 row + side) of the counted sides of asked bodies
+        for side, ids, offset in ((0, table.a, OFFSET_A), (1, table.b, OFFSET_B)):
+            rows = np.flatnonzero((slot[ids] >= 0) & pressed & (work - d[offset] >= self.emin))
+            sides.append(2 * rows + side)
+        # each body's sum in the order of its rows, as stored_share adds them; a few sides
+        totals = [0.0] * len(bodies)
+        stored, physs, a, b = self.law.stored, table.physs, table.a, table.b
+        for s in np.sort(np.concatenate(sides)).tolist():
+            row, side = divmod(s, 2)
+            share = float(d[SHARE_B if side else SHARE_A, row])
+            body = b[row] if side else a[row]
+            totals[slot[body]] += share * stored(physs[row].kno, float(overlap[row]))
+        return totals
 
     def held(self, body):
         """Elastic energy (J) a body's volumetric contacts hold, both sides

@@ -5,6 +5,7 @@ contact, until numpy needs the block). Saved with the scene in FIELDS' order."""
 from __future__ import annotations
 
 from itertools import chain
+from operator import itemgetter
 
 import numpy as np
 
@@ -70,6 +71,9 @@ class ContactTable:
         self.by_body = by_body
         self.index = index
         self._pairs = None
+        #: the rows the last numpy read left as they were (zeroed pairs asleep: slack, kno 0);
+        #: None: every row was read
+        self.resting = None
         self.incomplete = incomplete
 
     def __len__(self):
@@ -108,8 +112,9 @@ class ContactTable:
 
     def keep(self, rows):
         """Only the rows `rows` (indices, in order) stay."""
-        self.set(self.a[rows], self.b[rows], self.data[:, rows],
-                 [self.geoms[k] for k in rows.tolist()], [self.physs[k] for k in rows.tolist()])
+        kept = rows.tolist()
+        self.set(self.a[rows], self.b[rows], self.data[:, rows], take(self.geoms, kept),
+                 take(self.physs, kept))
 
     def append(self, a, b, data, geoms, physs):
         """New rows (ids, numbers FIELDS x new, YADE's objects) after the present ones."""
@@ -155,6 +160,13 @@ class ContactTable:
                  [None] * len(rows), [None] * len(rows), incomplete=bool(rows))
 
 
+def take(values, indices):
+    """[values[k] for k in indices], in C (a cloud's table keeps thousands of rows)."""
+    if len(indices) < 2:
+        return [values[k] for k in indices]
+    return list(itemgetter(*indices)(values))
+
+
 class RowPairs:
     """The rows' pairs as (smaller id, larger id), made once per read when asked: as pair_codes
     and as tuples, and which of them are in a set of pairs."""
@@ -162,6 +174,9 @@ class RowPairs:
     def __init__(self, a, b):
         self.lo, self.hi = np.minimum(a, b), np.maximum(a, b)
         self._codes = self._tuples = None
+
+    def __len__(self):
+        return len(self.lo)
 
     def among(self, pairs, within=None):
         """Which rows are pairs of the set `pairs`: each row looked up when the set is the larger
