@@ -29,8 +29,6 @@ from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OVERLAP, SHARE_
 #: with numpy: measured, the scalar path costs about 1.7 us per contact, the numpy one about
 #: 0.7 us per contact plus 100 us per read (per step, see the module's docstring)
 SMALL = 150
-#: stored_share takes a body's rows at once from this many on
-VECTOR_ROWS = 8
 #: the contact laws whose work a reader counts
 LAWS = ("hertz_mindlin", "volumetric")
 
@@ -87,14 +85,11 @@ class ContactReader:
         table = self.table
         if self.volumetric:
             return held_share(table, body, self.cs, self.emin)
-        sides = table.rows_of(body)
-        # a body of many contacts (a fragment in its cloud): which count, at once from the numpy
-        # block; below VECTOR_ROWS the loop is the cheaper (numpy's cost per call)
-        if table.is_block and len(sides) >= VECTOR_ROWS:
-            return self._stored_share_block(sides)
+        if table.is_block:
+            return self.stored_shares([body])[0]
         total = 0.0
         value = table.value
-        for row, side in sides:
+        for row, side in table.rows_of(body):
             offset = value(row, OFFSET_B if side else OFFSET_A)
             overlap = value(row, OVERLAP)
             if table.total(row, self.cs) - offset >= self.emin and overlap > 0.0:
@@ -103,11 +98,11 @@ class ContactReader:
         return total
 
     def stored_shares(self, bodies):
-        """stored_share of each of `bodies` (a list), at once: one numpy pass over the block's
-        rows for many bodies (an open event in a fragment cloud asks every read whether its body
-        unloaded), the same sums in the same order as stored_share body by body."""
+        """stored_share of each of `bodies` (a list). On the numpy block, at once: a fragment
+        cloud's open events ask every read whether their bodies unloaded. Each body's sum is
+        taken in the order of its rows, as the loop over a body's rows takes it."""
         table = self.table
-        if self.volumetric or not table.is_block or len(bodies) < 2:
+        if self.volumetric or not table.is_block:
             return [self.stored_share(b) for b in bodies]
         d = table.data
         overlap, work = d[OVERLAP], total_work(d[WORK], d[SHEAR_WORK], self.cs)
@@ -121,10 +116,9 @@ class ContactReader:
         for side, ids, offset in ((0, table.a, OFFSET_A), (1, table.b, OFFSET_B)):
             rows = np.flatnonzero((slot[ids] >= 0) & pressed & (work - d[offset] >= self.emin))
             sides.append(2 * rows + side)
-        # each body's sum in the order of its rows, as stored_share adds them; a few sides
         totals = [0.0] * len(bodies)
         stored, physs, a, b = self.law.stored, table.physs, table.a, table.b
-        for s in np.sort(np.concatenate(sides)).tolist():
+        for s in np.sort(np.concatenate(sides)).tolist():        # a few sides
             row, side = divmod(s, 2)
             share = float(d[SHARE_B if side else SHARE_A, row])
             body = b[row] if side else a[row]
