@@ -3,10 +3,10 @@ interactions, for a few contacts; numpy over the rows kept, with new contacts lo
 around the bodies whose count of interactions changed, for many) read the same scene alike: the
 same contacts with the same numbers bit for bit, the same energies (to round-off: the rows are
 summed in another order), strongest contacts and growing bodies, through impacts, breakage,
-zeroed and sleeping pairs and inherited contacts, with and without shear work; and the numpy
-path reads alike whether it looks every row up in the zeroed and sleeping pairs or follows the
-pairs the zeroing changed, and tells what bodies' contacts hold alike for one body or many. The physics both
-call (HertzMindlinWork, own_share) is tested on closed forms in test_engine_parts.py."""
+zeroed and sleeping pairs and inherited contacts, with and without shear work. The numpy path
+reads alike whether it looks every row up in the zeroed and sleeping pairs or follows the pairs
+the zeroing changed, and tells what bodies' contacts hold as the scalar path does. The physics
+both call (HertzMindlinWork, own_share) is tested on closed forms in test_engine_parts.py."""
 import numpy as np
 import pytest
 

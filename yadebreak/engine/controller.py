@@ -96,7 +96,7 @@ class Controller:
                       config.criteria.break_at == "peak", any(self.pause_steps.values()),
                       config.replacement.contact_energy_at_break == "carried")
         self.judge = Judge(self.state, self._criterion_of, self.reader, rules,
-                           record=self._record, warn_jump=self._warn_jump,
+                           record=self.record_event, warn_jump=self._warn_jump,
                            weakened=self.tracking.weakened)
         self.large_overlaps = (LargeOverlaps(config.replacement.overlap_factor)
                                if config.replacement.overlap_factor else None)
@@ -245,7 +245,8 @@ class Controller:
             f"the crossing gives {low:.2f} %"),
             remedies=self.schedule.remedies(), purpose="for an accurate t10'")
 
-    def _record(self, kind, bid, **fields):
+    def record_event(self, kind, bid, **fields):
+        """Log an event of body `bid` now (its radius and mass added)."""
         c = self.state.table.columns
         self.state.log.record({"kind": kind, "iter": O.iter, "time": O.time, "id": bid,
                                "radius": float(c["radius"][bid]), "mass": float(c["mass"][bid]),
@@ -259,7 +260,7 @@ class Controller:
         state, table = self.state, self.state.table
         c = table.columns
         new_dt = np.inf
-        dmin = self._dmin()
+        dmin = self.dmin()
         for bid, ek, strongest in broken:
             if bid not in state.tracked:
                 continue
@@ -270,7 +271,7 @@ class Controller:
             specific = ek / float(c["mass"][bid])
             if c["kind"][bid] == UNBREAKABLE:
                 c["t10"][bid] = t10                # keeps the t10' of its first would-be breakage
-                self._record("unbreakable_stressed", bid, specific_energy=specific,
+                self.record_event("unbreakable_stressed", bid, specific_energy=specific,
                              fracture_energy=energy, t10=t10)
                 continue
             c["kind"][bid] = BROKEN
@@ -290,11 +291,12 @@ class Controller:
                                             default=0.0))
                 for radius, material in progeny.smallest:
                     new_dt = min(new_dt, self.time_step.for_fragments(radius, material))
-            self._record("breakage", bid, **event)
+            self.record_event("breakage", bid, **event)
         self.time_step.lower(new_dt, self.reader.bodies_in_contact)
         self.wall_time["replace"] += time.perf_counter() - t0
 
-    def _dmin(self):
+    def dmin(self):
+        """The smallest fragment size (m) replacement places now: the option, else top size / 20."""
         dmin = self.config.replacement.dmin
         return dmin if dmin is not None else self.state.top_size / 20.0
 

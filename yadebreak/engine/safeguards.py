@@ -43,14 +43,14 @@ class LargeOverlaps:
         """The breakable bodies of controller `ctl` with a contact past the limit at this read,
         less those `broken` already: each breaks now at its present energy (returned as
         judge() returns breakages), or leaves for the ledger if too small to break."""
-        dmin, table = ctl._dmin(), ctl.state.table
+        dmin, table = ctl.dmin(), ctl.state.table
         due = []
         for bid in self.find(ctl.reader.table, ctl.state.tracked, dmin, [b for b, _, _ in broken]):
             if table.kind_of(bid) != "breakable":
                 continue
             volume = float(table.columns["mass"][bid]) / O.bodies[bid].material.density
             removed = self.removed(volume, dmin)
-            ctl._record("large_overlap", bid, action="removed" if removed else "broken")
+            ctl.record_event("large_overlap", bid, action="removed" if removed else "broken")
             if removed:
                 to_ledger(ctl, bid)
             else:
