@@ -33,7 +33,9 @@ class ArrayRead:
         if tracked:
             mask[np.fromiter(tracked, np.int64, len(tracked))] = True
         flags = None                                    # which rows are zeroed, asleep
-        if zeroed:
+        if not zeroed:
+            self.zeroed_rows.forget()          # the changes told meanwhile are not followed
+        else:
             flags = self.zeroed_rows
             if table.incomplete:
                 flags.forget()

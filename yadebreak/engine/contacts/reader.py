@@ -70,6 +70,7 @@ class ContactReader:
             loading = read_each(self, interactions.all(True), bodies, tracked, zeroed, now,
                                 interval, asleep,
                                 self.last_time if self.last_time is not None else now)
+            self._read_arrays.zeroed_rows.forget()    # it does not follow the zeroing's changes
         else:
             loading = self._read_arrays(interactions, bodies, tracked, zeroed, now, interval,
                                         asleep, counts, zeroing_changes)
