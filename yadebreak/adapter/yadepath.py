@@ -26,12 +26,14 @@ def one_openmp_thread():
 def ensure_yade_importable():
     """Return True if yade can be imported, adding Debian's yade-double/py to sys.path if needed.
 
-    Also sets OMP_NUM_THREADS=1 unless the user chose otherwise, as the `yade` launcher does by
-    default (and one_openmp_thread, where libgomp was loaded first): imported into plain Python,
-    YADE would start one OpenMP thread per core, and with the other core busy every parallel region waits for a descheduled thread (measured: a
-    13-body scene at 30 ms per step instead of 0.25 ms while another job ran).
+    With OMP_NUM_THREADS=1 (`import yadebreak` sets it unless the user chose otherwise, as the
+    `yade` launcher does by default) it also holds libgomp to one thread where libgomp was
+    loaded first (one_openmp_thread): imported into plain Python, YADE would start one OpenMP
+    thread per core, and with the other core busy every parallel region waits for a descheduled
+    thread (measured: a 13-body scene at 30 ms per step instead of 0.25 ms while another job
+    ran).
     """
-    if os.environ.setdefault("OMP_NUM_THREADS", "1") == "1":
+    if os.environ.get("OMP_NUM_THREADS") == "1":
         one_openmp_thread()
     if importlib.util.find_spec("yade") is not None:
         try:

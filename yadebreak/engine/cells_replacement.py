@@ -148,9 +148,10 @@ class CellBreakage:
         energy (J) its contacts held; `neighbours`: the ids it touched, whose contacts with the
         cells count work from the state they start in (the reader's inherit). Returns the fields
         of replacement.Progeny: fragment ids, t10', speed excess, smallest, audit. No contact is
-        made here (elastic_energy_after 0): the collider finds the cells' contacts. They touch face to face: on the volumetric law
-        a shared face makes no force; through Ig2_Polyhedra_Polyhedra_ScGeom they start with
-        an overlap and fly apart (docs/polyhedra.md)."""
+        made here (elastic_energy_after 0): the collider finds the cells' contacts. They touch
+        face to face: on the volumetric law a shared face makes no force; through
+        Ig2_Polyhedra_Polyhedra_ScGeom they start with an overlap and fly apart
+        (docs/polyhedra.md)."""
         rep = self.replacer
         table, body = rep.table, O.bodies[bid]
         label = table.label_of(bid)

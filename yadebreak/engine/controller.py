@@ -272,7 +272,7 @@ class Controller:
             if c["kind"][bid] == UNBREAKABLE:
                 c["t10"][bid] = t10                # keeps the t10' of its first would-be breakage
                 self.record_event("unbreakable_stressed", bid, specific_energy=specific,
-                             fracture_energy=energy, t10=t10)
+                                  fracture_energy=energy, t10=t10)
                 continue
             c["kind"][bid] = BROKEN
             event = {"specific_energy": specific, "fracture_energy": energy, "ratio": ratio,

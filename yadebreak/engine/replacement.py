@@ -297,7 +297,7 @@ class Replacer:
         index = {i: k for k, i in enumerate(ids)}
         for a, b, _, _ in pairs:
             energy = contact_elastic_energy(O.interactions[a, b],
-                                     self.zeroing.pairs.get((min(a, b), max(a, b))))
+                                            self.zeroing.pairs.get((min(a, b), max(a, b))))
             total += energy
             for i in (a, b):
                 if i in index:

@@ -8,7 +8,6 @@ SET/k.tally.json (the parent's sign that the scene is done); a spec with a "task
 ("module:function") calls function(spec, k) instead and writes what it returns there.
 PACKAGE is the parent's yadebreak, wherever it lives. Coupling layer: imports yade.
 """
-import importlib
 import json
 import os
 import signal
@@ -25,7 +24,7 @@ sys.path.insert(0, package)
 
 from yadebreak import scenes  # noqa: E402
 from yadebreak.scenes.view import close_remote_access  # noqa: E402
-from yadebreak.scenes.impact_pool import claim  # noqa: E402
+from yadebreak.scenes.impact_pool import call_task, claim  # noqa: E402
 
 #: how often an idle worker looks at the queue (s)
 IDLE_S = 0.05
@@ -35,8 +34,7 @@ def run_one(task):
     folder, k = Path(task["set"]), int(task["scene"])
     spec = json.loads((folder / "spec.json").read_text())
     if "task" in spec:
-        module, name = spec["task"].split(":")
-        done = getattr(importlib.import_module(module), name)(spec, k)
+        done = call_task(spec, k)
     else:
         done = scenes.run_scenes(spec, [k], folder / f"{k}.jsonl")[0].to_dict()
     tmp = folder / f"{k}.tally.tmp"

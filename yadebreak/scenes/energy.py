@@ -17,8 +17,8 @@ class EnergyNow(NamedTuple):
     zeroed overlaps as the zero of their contacts), and what has been lost since
     track_energy(): the normal and shear dashpots and friction slip (ContactDissipation), and
     from YADE's O.energy: Newton's damping ('nonviscDamp': the engine's global damping of
-    fragments) and gravity's (O.energy 'gravWork', counted as YADE does: the energy total stays constant); the
-    kinetic energy the fines ledger carries (dummies="ledger")."""
+    fragments) and gravity's (O.energy 'gravWork', counted as YADE does: the energy total stays
+    constant); the kinetic energy the fines ledger carries (dummies="ledger")."""
 
     kinetic: dict
     elastic: float
@@ -39,11 +39,12 @@ class ContactDissipation(Part):
     displacement of the two bodies' material points at the contact point (velocities v + w x r,
     averaged over the step, as the leapfrog's kinetic energy changes). The viscous part
     (shearForce less shearElastic) is the shear dashpot; friction slip is the elastic part's
-    work less the rise of its elastic energy |Fs|^2 / (2 ks), plus that energy where a pair separates (a pair lost to a breakage is in
-    the breakage's elastic_energy_before). ScGeom's shearInc is not that displacement where the
-    overlap is deep (a fragment's zeroed one): counted with it, friction ran 1.2 % of E0 over
-    400 steps of a granulite cloud above the work the forces did. A contact of a body replaced
-    at this step is not read: its force never acted."""
+    work less the rise of its elastic energy |Fs|^2 / (2 ks), plus that energy where a pair
+    separates (a pair lost to a breakage is in the breakage's elastic_energy_before). ScGeom's
+    shearInc is not that displacement where the overlap is deep (a fragment's zeroed one):
+    counted with it, friction ran 1.2 % of E0 over 400 steps of a granulite cloud above the work
+    the forces did. A contact of a body replaced at this step is not read: its force never
+    acted."""
 
     kind = "energy_audit"
 

@@ -166,6 +166,14 @@ def _merged(size, tallies):
     return tally
 
 
+def call_task(spec, k):
+    """Scene k of a task's spec: function(spec, k) for spec["task"] = "module:function" (in a
+    worker, or in the process that would have queued it)."""
+    import importlib
+    module, name = spec["task"].split(":")
+    return getattr(importlib.import_module(module), name)(spec, k)
+
+
 def claim(folder, worker):
     """The next scene of the queue in `folder` for `worker`: {"set": folder, "scene": k}, or None
     if the queue is empty (the worker's side)."""

@@ -87,9 +87,8 @@ class Task:
     cost: float
 
     def call(self, k):
-        import importlib
-        module, name = self.spec["task"].split(":")
-        return getattr(importlib.import_module(module), name)(self.spec, k)
+        from yadebreak.scenes.impact_pool import call_task
+        return call_task(self.spec, k)
 
 
 class Runner:
