@@ -94,6 +94,20 @@ def test_damage_of_one_ratio_is_the_arrays_damage(gamma):
     assert isinstance(model.damage(0.3, gamma), float)
 
 
+@pytest.mark.parametrize("gamma", [0.5, 2.0, 5.0, 50.0])
+def test_damage_of_a_light_touch_is_eq6_limit(gamma):
+    """Ratios far below 1 (tough particles touched lightly at process scale): D tends to
+    g(0) = (2 gamma / (2 gamma + 5) r)^(2 gamma / 5), Eq. 6 with D = 0 on its right, and both
+    paths give it to round-off (the scalar path returns that end of the bracket directly)."""
+    r = np.geomspace(1e-300, 1e-6, 40)
+    limit = (2 * gamma / (2 * gamma + 5) * r) ** (2 * gamma / 5)
+    one = np.array([model.damage(float(x), gamma) for x in r])
+    np.testing.assert_allclose(one, model.damage(r, gamma), rtol=1e-11, atol=0)
+    tiny = limit < 1e-14                        # 5 D / (2 gamma + 5) below round-off of 1
+    np.testing.assert_allclose(one[tiny], limit[tiny], rtol=1e-11, atol=0)
+    assert np.all(np.diff(one[one > 0.0]) > 0)      # (large gammas underflow to 0)
+
+
 def test_damage_by_fixed_point_from_zero_agrees():
     # The paper solves Eq. 6 "iteratively from an initial guess of D = 0".
     r, gamma = 0.6, 5.0

@@ -215,11 +215,21 @@ def _damage_one(ratio, gamma):
     p = 5.0 / (2.0 * gamma)
     lo = q * (log_r + math.log(2.0 * gamma / (2.0 * gamma + 5.0)))
     hi = q * log_r
+    converged = 4e-16 * max(1.0, abs(log_r))             # a residual at round-off
+
+    def residual(y):
+        return (p * y + math.log(2.0 * gamma + 5.0 - 5.0 * math.exp(y)) - math.log(2.0 * gamma)
+                - log_r)
+    if abs(residual(lo)) <= converged:
+        # D so small (below about 1e-14) that the root is ln g(0) to round-off: Newton's steps
+        # land on that end of the bracket and bisection would take some fifty steps to get there
+        # (light touches of tough particles at process scale: 25 us a closing event)
+        return min(math.exp(lo), math.nextafter(1.0, 0.0))
     y = 0.5 * (lo + hi)
     for _ in range(100):
         d = math.exp(y)
-        f = p * y + math.log(2.0 * gamma + 5.0 - 5.0 * d) - math.log(2.0 * gamma) - log_r
-        if abs(f) <= 4e-16 * max(1.0, abs(log_r)):      # a root to round-off: Newton would only
+        f = residual(y)
+        if abs(f) <= converged:                        # a root to round-off: Newton would only
             break                                      # bounce off the bracket from here
         if f < 0.0:
             lo = y

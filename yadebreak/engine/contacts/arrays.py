@@ -288,21 +288,24 @@ class ArrayRead:
         sides = np.flatnonzero(counted)
         if not len(sides):
             return Loading(grew=grew)
-        ids, group = np.unique(body[sides], return_inverse=True)
-        values = share[sides]
-        sums = np.bincount(group, weights=values, minlength=len(ids))
-        # strongest: the first side of each body with the largest share (a loop's strict >)
-        best = np.lexsort((sides, -values, group))
+        owner, values = body[sides], share[sides]
+        # each body's sum over its sides in their order (bincount adds in the order given)
+        ids = np.flatnonzero(np.bincount(owner))
+        sums = np.bincount(owner, weights=values)[ids]
+        # strongest: the first side of each body with the largest share (a loop's strict >);
+        # lexsort is stable: among equal shares the first side comes first
+        best = np.lexsort((-values, owner))
+        ranked = owner[best]
         head = np.empty(len(best), bool)
         head[0] = True
-        head[1:] = group[best][1:] != group[best][:-1]
+        head[1:] = ranked[1:] != ranked[:-1]
         heads = best[head]
-        found = {}
-        for g, s, value in zip(group[heads].tolist(), sides[heads].tolist(),
-                               values[heads].tolist()):
-            if value > 0.0:
-                row, side = divmod(s, 2)
-                found[int(ids[g])] = (value, row, -1.0 if side else 1.0,
-                                      int(table.a[row] if side else table.b[row]))
+        heads = heads[values[heads] > 0.0]
+        # body -> (share, row, sign, partner), built in C: a cloud has hundreds of bodies
+        row, side = np.divmod(sides[heads], 2)
+        b_side = side.astype(bool)
+        found = dict(zip(owner[heads].tolist(), zip(
+            values[heads].tolist(), row.tolist(), np.where(b_side, -1.0, 1.0).tolist(),
+            np.where(b_side, table.a[row], table.b[row]).tolist())))
         return Loading(dict(zip(ids.tolist(), sums.tolist())),
                        StrongestContacts(found, table.geoms), grew)
