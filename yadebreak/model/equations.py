@@ -217,18 +217,18 @@ def _damage_one(ratio, gamma):
     hi = q * log_r
     converged = 4e-16 * max(1.0, abs(log_r))             # a residual at round-off
 
-    def residual(y):
-        return (p * y + math.log(2.0 * gamma + 5.0 - 5.0 * math.exp(y)) - math.log(2.0 * gamma)
-                - log_r)
-    if abs(residual(lo)) <= converged:
+    def residual(y, d):                                  # d = exp(y)
+        return p * y + math.log(2.0 * gamma + 5.0 - 5.0 * d) - math.log(2.0 * gamma) - log_r
+    d = math.exp(lo)
+    if abs(residual(lo, d)) <= converged:
         # D so small (below about 1e-14) that the root is ln g(0) to round-off: Newton's steps
         # land on that end of the bracket and bisection would take some fifty steps to get there
         # (light touches of tough particles at process scale: 25 us a closing event)
-        return min(math.exp(lo), math.nextafter(1.0, 0.0))
+        return min(d, math.nextafter(1.0, 0.0))
     y = 0.5 * (lo + hi)
     for _ in range(100):
         d = math.exp(y)
-        f = residual(y)
+        f = residual(y, d)
         if abs(f) <= converged:                        # a root to round-off: Newton would only
             break                                      # bounce off the bracket from here
         if f < 0.0:

@@ -131,21 +131,6 @@ class ContactReader:
         (contacts/volumetric)."""
         return held_total(self.table, body)
 
-    def _stored_share_block(self, sides):
-        rows = np.fromiter((r for r, _ in sides), np.int64, len(sides))
-        b = np.fromiter((s for _, s in sides), bool, len(sides))
-        d = self.table.data
-        overlap = d[OVERLAP, rows]
-        counted = ((total_work(d[WORK, rows], d[SHEAR_WORK, rows], self.cs)
-                    - np.where(b, d[OFFSET_B, rows], d[OFFSET_A, rows]) >= self.emin)
-                   & (overlap > 0.0))
-        share = np.where(b, d[SHARE_B, rows], d[SHARE_A, rows])
-        total = 0.0
-        for k in np.flatnonzero(counted).tolist():   # the sum in the rows' order, as the loop
-            total += float(share[k]) * self.law.stored(self.table.physs[int(rows[k])].kno,
-                                                       float(overlap[k]))
-        return total
-
     def restart(self, body):
         """Count a body's energy from now on: its offsets become its contacts' present work."""
         table = self.table
