@@ -17,8 +17,10 @@ def _same_loading(x, y):
     assert x.energy.keys() == y.energy.keys() and x.grew == y.grew
     for body, energy in x.energy.items():
         assert y.energy[body] == pytest.approx(energy, rel=1e-12, abs=1e-300)
+        px, py = x.strongest.partner(body), y.strongest.partner(body)   # before get() makes it
         sx, sy = x.strongest.get(body), y.strongest.get(body)
         assert (sx is None) == (sy is None)
+        assert px == py == (-1 if sx is None else sx.other)
         if sx is not None:
             assert sx[0] == sy[0] and sx[2:] == sy[2:] and tuple(sx[1]) == tuple(sy[1])
 

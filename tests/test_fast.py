@@ -158,6 +158,24 @@ def test_a_coarse_fixed_period_warns_and_says_how_wrong_t10_is(scene):
     assert abs(at_crossing - every[0]["t10"]) < 0.2
 
 
+def test_hertz_onset_time_of_one_body_is_the_array_value():
+    """A damage updates one body's onset bound on floats (Reach.update); the scan of every body
+    takes arrays (Tracking._rebuild_reach): the numbers of 0-d arrays exactly, of numpy's
+    vectorised power to its last bit."""
+    rng = np.random.default_rng(5)
+    n = 300
+    radius, density = 10 ** rng.uniform(-5, -1, n), rng.uniform(1e3, 8e3, n)
+    young, poisson = 10 ** rng.uniform(8, 12, n), rng.uniform(0.0, 0.49, n)
+    energy = 10 ** rng.uniform(-3, 33, n)
+    one = [placement.hertz_onset_time(float(r), float(d), float(y), float(p), 1.0, float(e))
+           for r, d, y, p, e in zip(radius, density, young, poisson, energy)]
+    assert all(type(x) is float for x in one)
+    assert one == [float(placement.hertz_onset_time(r, d, y, p, np.float64(1.0), e))
+                   for r, d, y, p, e in zip(radius, density, young, poisson, energy)]
+    np.testing.assert_allclose(one, placement.hertz_onset_time(radius, density, young, poisson,
+                                                               1.0, energy), rtol=5e-16, atol=0)
+
+
 def test_hertz_onset_time_against_an_integrated_hertz_impact():
     """The closed form e = 2 E* / (5 pi rho) (v t / R)^2.5 against the work of F = kno d^1.5
     integrated along a sphere's own Hertz impact on a rigid wall (semi-implicit Euler, 1e5

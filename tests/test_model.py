@@ -108,6 +108,18 @@ def test_damage_of_a_light_touch_is_eq6_limit(gamma):
     assert np.all(np.diff(one[one > 0.0]) > 0)      # (large gammas underflow to 0)
 
 
+def test_weakened_fracture_energy_of_one_body_is_the_array_value():
+    """A closing event weakens one body on floats: the numbers of a 0-d array exactly, of the
+    array path to round-off (Eq. 6's scalar and array solvers)."""
+    rng = np.random.default_rng(4)
+    energy, ratio = rng.uniform(1.0, 1e4, 400), 10 ** rng.uniform(-20, -1e-3, 400)
+    one = [model.weakened_fracture_energy(float(e), float(r), 2.5) for e, r in zip(energy, ratio)]
+    assert all(type(x) is float for x in one)
+    assert one == [float(model.weakened_fracture_energy(e, r, 2.5)) for e, r in zip(energy, ratio)]
+    np.testing.assert_allclose(one, model.weakened_fracture_energy(energy, ratio, 2.5),
+                               rtol=1e-12, atol=0)
+
+
 def test_damage_by_fixed_point_from_zero_agrees():
     # The paper solves Eq. 6 "iteratively from an initial guess of D = 0".
     r, gamma = 0.6, 5.0

@@ -17,7 +17,6 @@ from itertools import repeat
 import numpy as np
 
 from yadebreak.criteria import judge_all
-from yadebreak.engine.contacts import NO_PARTNER
 
 #: up to this many bodies in a read are judged one by one, unless a criterion of the scene says
 #: fewer (its `judged_one_by_one`, where the two paths cost the same)
@@ -137,7 +136,7 @@ class Judge:
                 need[k] = BREAK
             elif e > before:
                 c["event_max"][i] = e
-                c["event_partner"][i] = loading.strongest.get(i, NO_PARTNER).other
+                c["event_partner"][i] = loading.strongest.partner(i)
                 need[k] = OPEN
             elif before > 0.0:
                 need[k] = CLOSE_IF_UNLOADED
@@ -177,8 +176,8 @@ class Judge:
         grows = active & ~breaks & (ek > event_max)
         c["specific_energy"][ids[active]] = specific[active]
         c["event_max"][ids[grows]] = ek[grows]
-        c["event_partner"][ids[grows]] = [loading.strongest.get(i, NO_PARTNER).other
-                                          for i in ids[grows].tolist()]
+        c["event_partner"][ids[grows]] = list(map(loading.strongest.partner,
+                                                  ids[grows].tolist()))
         c["event_max"][ids[paused]] = 0.0
         c["specific_energy"][ids[paused]] = 0.0
         need = np.full(n, NOTHING, np.int8)

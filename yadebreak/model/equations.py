@@ -247,8 +247,11 @@ def _damage_one(ratio, gamma):
 
 
 def weakened_fracture_energy(energy, ratio, gamma):
-    """Eq. 5: E' = E (1 - D), D from Eq. 6 at ratio r = Ek'_max / (mp E); energies in J/kg."""
-    return np.asarray(energy, dtype=float) * (1.0 - damage(ratio, gamma))
+    """Eq. 5: E' = E (1 - D), D from Eq. 6 at ratio r = Ek'_max / (mp E); energies in J/kg. On a
+    float energy, a float (a stressing event closes with one call)."""
+    if type(energy) is not float:
+        energy = np.asarray(energy, dtype=float)
+    return energy * (1.0 - damage(ratio, gamma))
 
 
 def parabolic_peak(t0, x0, t1, x1, t2, x2):

@@ -155,12 +155,18 @@ def hertz_onset_time(radius, density, young, poisson, speed, specific_energy):
     time): W / m = 0.4 kno (v t)^2.5 / m with kno = 4/3 E* sqrt(R), i.e.
     e = 2 E* / (5 pi rho) (v t / R)^2.5, E* = Y / (1 - nu^2). A softer partner or a slower
     closing takes longer, so this is the shortest time in which a fresh contact can bring a
-    sphere of this size that much energy. SI units."""
-    e_star = np.asarray(young, dtype=float) / (1.0 - np.asarray(poisson, dtype=float) ** 2)
-    speed = np.maximum(np.asarray(speed, dtype=float), 1e-12)
-    scale = 5.0 * np.pi * np.asarray(density, dtype=float) / (2.0 * e_star)
-    return np.asarray(radius, dtype=float) / speed * (np.asarray(specific_energy, float)
-                                                      * scale) ** 0.4
+    sphere of this size that much energy. SI units. On floats it computes on floats (a damage
+    updates one body's bound; 0-d arrays cost microseconds), with the operations numpy's take,
+    so the same numbers."""
+    if all(type(x) is float for x in (radius, density, young, poisson, speed, specific_energy)):
+        speed = max(speed, 1e-12)
+    else:
+        radius, density, young, poisson, specific_energy = (
+            np.asarray(x, dtype=float) for x in (radius, density, young, poisson, specific_energy))
+        speed = np.maximum(np.asarray(speed, dtype=float), 1e-12)
+    e_star = young / (1.0 - poisson * poisson)
+    scale = 5.0 * np.pi * density / (2.0 * e_star)
+    return radius / speed * (specific_energy * scale) ** 0.4
 
 
 def pouring_column(count, radius, holder_radius, rng, gap=0.1):

@@ -14,10 +14,6 @@ class Strongest(NamedTuple):
     other: int            # the partner's body id (-1: none)
 
 
-#: the strongest contact of a body whose contacts brought no energy above emin: no partner
-NO_PARTNER = Strongest(0.0, None, 0.0, -1)
-
-
 class StrongestContacts:
     """body -> its Strongest contact at a read; the normal is fetched from YADE only for the
     bodies asked for."""
@@ -29,6 +25,14 @@ class StrongestContacts:
 
     def __setitem__(self, body, value):
         self._made[body] = value
+
+    def partner(self, body):
+        """The partner's id of a body's strongest contact (-1: none), without YADE's normal."""
+        made = self._made.get(body)
+        if made is not None:
+            return made.other
+        found = self._found.get(body)
+        return -1 if found is None else found[3]
 
     def get(self, body, default=None):
         made = self._made.get(body)

@@ -4,6 +4,7 @@ block FIELDS x contacts (after a numpy read) or as one list per contact (after a
 contact, until numpy needs the block). Saved with the scene in FIELDS' order."""
 from __future__ import annotations
 
+from functools import lru_cache
 from itertools import chain
 from operator import itemgetter
 
@@ -30,10 +31,15 @@ def pair_codes(id1, id2):
 def fresh_row(stiffness, bodies, a, b, now):
     """The numbers (FIELDS) of a contact between bodies a and b seen first at `now`: no work
     yet, Eq. 4's shares from the Hertz stiffness (Pa) of each body's YADE material id."""
-    ka = stiffness[bodies[a].material.id]
-    kb = stiffness[bodies[b].material.id]
-    return [0.0, 0.0, 0.0, 0.0, 0.0, float(model.energy_partition(ka, kb)),
-            float(model.energy_partition(kb, ka)), 0.0, 0.0, 0.0, 0.0, now, now]
+    share_a, share_b = _shares(stiffness[bodies[a].material.id], stiffness[bodies[b].material.id])
+    return [0.0, 0.0, 0.0, 0.0, 0.0, share_a, share_b, 0.0, 0.0, 0.0, 0.0, now, now]
+
+
+@lru_cache(maxsize=None)
+def _shares(ka, kb):
+    """Eq. 4's shares of bodies of stiffness ka and kb (Pa): a scene has a few materials, and
+    collisions make thousands of fresh rows."""
+    return float(model.energy_partition(ka, kb)), float(model.energy_partition(kb, ka))
 
 
 def _column(k):
