@@ -2,7 +2,9 @@
 YADE (about 0.5 us per contact), their work and sums in numpy; new contacts are looked for only
 around the tracked bodies whose count of real interactions (one C++ call for all the bodies)
 differs from their rows: no pass over every interaction in Python. It gives the numbers the read
-contact by contact (each.py) gives (tests/test_contact_paths.py)."""
+contact by contact (each.py) gives (tests/test_contact_paths.py). Rows are found with
+mask.nonzero()[0]: np.flatnonzero's dispatch layers cost more than the search over a cloud's
+table, a dozen times a read."""
 from __future__ import annotations
 
 import numpy as np
@@ -69,7 +71,7 @@ class ArrayRead:
         fragment clouds of a cascade are mostly such pairs."""
         table = self.table
         physs = table.physs if update is None else take(table.physs,
-                                                        np.flatnonzero(update).tolist())
+                                                        update.nonzero()[0].tolist())
         m = len(physs)
 
         def kept(got, stored):                 # the rows read, the others as they were
@@ -128,7 +130,7 @@ class ArrayRead:
             delta = np.fromiter([g.penetrationDepth for g in geoms], float, len(table))
         else:
             delta = table.overlap.copy()
-            read = np.flatnonzero(~resting)
+            read = (~resting).nonzero()[0]
             delta[read] = np.fromiter([g.penetrationDepth for g in take(geoms, read.tolist())],
                                       float, len(read))
         keep = (delta >= 0.0) & (mask[table.a] | mask[table.b])
@@ -137,13 +139,13 @@ class ArrayRead:
             gone[np.fromiter(erased, np.int64, len(erased))] = True
             keep &= ~(gone[table.a] | gone[table.b])
         if not keep.all():
-            rows = np.flatnonzero(keep)
+            rows = keep.nonzero()[0]
             table.keep(rows)
             delta, restored = delta[rows], restored[rows]
             if flags is not None:
                 flags.keep(rows)
         have = np.bincount(np.concatenate((table.a, table.b)), minlength=len(mask))
-        changed = np.flatnonzero(mask & (have != np.asarray(counts(), np.int64)))
+        changed = (mask & (have != np.asarray(counts(), np.int64))).nonzero()[0]
         fresh = None
         if len(changed):
             kept, new = self._rescan(interactions, bodies, changed, now)
@@ -179,12 +181,12 @@ class ArrayRead:
         touched = is_changed[table.a] | is_changed[table.b]
         keys = list(zip(table.a[touched].tolist(), table.b[touched].tolist()))
         known = set(keys)
-        stale = [k for k, key in zip(np.flatnonzero(touched).tolist(), keys) if key not in current]
+        stale = [k for k, key in zip(touched.nonzero()[0].tolist(), keys) if key not in current]
         kept = None
         if stale:
             keep = np.ones(len(table), bool)
             keep[stale] = False
-            kept = np.flatnonzero(keep)
+            kept = keep.nonzero()[0]
             table.keep(kept)
         new = [inter for key, inter in current.items() if key not in known]
         if new:
@@ -216,13 +218,13 @@ class ArrayRead:
         everyone = update is None
         grows = delta > d0 if everyone else update & (delta > d0)
         worked = grows
-        rows = np.flatnonzero(grows)
+        rows = grows.nonzero()[0]
         if len(rows):
             table.work[rows] += self._loading_work(rows, d0, delta, force, hertz, interval)
         peaked = _law.peaked(d0, delta, table.overlap_before, table.time_before, table.time_read)
         if not everyone:
             peaked &= update
-        for k in np.flatnonzero(peaked).tolist():        # sparse reads only: a few per impact
+        for k in peaked.nonzero()[0].tolist():           # sparse reads only: a few per impact
             if hertz is not None and not hertz[k]:
                 continue                                 # zeroed pairs: the peak is d0, no work
             work = _law.past_peak(float(d0[k]), float(table.force[k]), table.physs[k].kno,
@@ -285,12 +287,12 @@ class ArrayRead:
         counted[1::2] &= in_b
         grew = set(table.a[in_a & worked].tolist())
         grew.update(table.b[in_b & worked].tolist())
-        sides = np.flatnonzero(counted)
+        sides = counted.nonzero()[0]
         if not len(sides):
             return Loading(grew=grew)
         owner, values = body[sides], share[sides]
         # each body's sum over its sides in their order (bincount adds in the order given)
-        ids = np.flatnonzero(np.bincount(owner))
+        ids = np.bincount(owner).nonzero()[0]
         sums = np.bincount(owner, weights=values)[ids]
         # strongest: the first side of each body with the largest share (a loop's strict >);
         # lexsort is stable: among equal shares the first side comes first

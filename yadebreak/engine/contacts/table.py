@@ -192,7 +192,7 @@ class RowPairs:
         if not pairs:
             return np.zeros(n, bool)
         if within is not None:
-            rows = np.flatnonzero(within)
+            rows = within.nonzero()[0]
             tuples = self._tuple_list()
             found = np.zeros(n, bool)
             found[rows] = np.fromiter(map(pairs.__contains__, [tuples[k] for k in rows.tolist()]),

@@ -21,7 +21,7 @@ class ZeroedRows:
         (smaller id, larger id)), else every row looked up. Returns (zeroed, asleep)."""
         if self.pairs is pairs and changed is not None:
             if changed:
-                rows = np.flatnonzero(pairs.among(changed))
+                rows = pairs.among(changed).nonzero()[0]
                 keys = zip(pairs.lo[rows].tolist(), pairs.hi[rows].tolist())
                 for k, key in zip(rows.tolist(), keys):
                     self.zeroed[k] = key in zeroed
