@@ -53,19 +53,22 @@ def test_poured_only_for_several_layers(scene, tmp_path):
 
 def test_the_run_reports_its_bed_and_rolling_friction(scene, tmp_path):
     """summary.json: bed_packing, the bed's kinetic energy at the ball's touch (a settled bed is
-    at rest: below 1e-6 of the impact energy) and the rolling friction of each pair."""
+    at rest: below 1e-6 of the impact energy) and the rolling friction of each pair. The run
+    stops at 25 ms, after the ball's touch (23 ms) and its first breakages: the time step falls
+    twentyfold with the fragments, and the rest of the run (1.2 million steps to its end, 82 s)
+    would add nothing here; a poured bed's run to its end is the Fig. 22 test's."""
     from yadebreak.jobs import bed
     args = argparse.Namespace(material="copper_ore", size=SIZE, rings=1, layers=3, energy=1.0,
                               speed=0.0, seed=1, time_step_fraction=0.05, dmin=0.0,
                               global_damping="material", dummies="ledger", read_period="fast",
-                              max_time=0.05, out=str(tmp_path / "run"), packing="auto",
+                              max_time=0.025, out=str(tmp_path / "run"), packing="auto",
                               rolling_friction=True, steel_rolling_friction=0.33,
                               bed_cache=str(tmp_path / "cache"))
     brk, summary = bed.run(args, quiet=True)
     assert summary["bed_packing"] == "poured"
     assert summary["rolling_friction"] == {"particle_particle": 0.27, "particle_steel": 0.33}
     assert 0.0 <= summary["bed_kinetic_energy_at_touch"] < 1e-6 * summary["energy"]
-    assert summary["end_reason"] == "finished"
+    assert summary["end_reason"] == "time_limit" and summary["breakage_events"] > 0
     assert summary["final_mass"] == pytest.approx(summary["initial_mass"], rel=1e-9)
 
 
