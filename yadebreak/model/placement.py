@@ -156,7 +156,7 @@ def hertz_onset_time(radius, density, young, poisson, speed, specific_energy):
     e = 2 E* / (5 pi rho) (v t / R)^2.5, E* = Y / (1 - nu^2). A softer partner or a slower
     closing takes longer, so this is the shortest time in which a fresh contact can bring a
     sphere of this size that much energy. SI units. On floats it computes on floats (a damage
-    updates one body's bound; 0-d arrays cost microseconds), with the operations numpy's take,
+    updates one body's bound; 0-d arrays cost microseconds), with the operations numpy takes,
     so the same numbers."""
     if all(type(x) is float for x in (radius, density, young, poisson, speed, specific_energy)):
         speed = max(speed, 1e-12)

@@ -113,17 +113,18 @@ class ContactReader:
         slot = np.full(max(int(table.a.max(initial=0)), int(table.b.max(initial=0)),
                            max(bodies)) + 1, -1, np.int64)
         slot[bodies] = np.arange(len(bodies))     # body id -> its place in `bodies`
-        sides = []                      # (2 row + side) of the counted sides of asked bodies
+        # the counted sides of the asked bodies, each contact's a before its b (as arrays.py
+        # lays them out): in the order of each body's rows
+        counted = np.empty(2 * len(table), bool)
         for side, ids, offset in ((0, table.a, OFFSET_A), (1, table.b, OFFSET_B)):
-            rows = ((slot[ids] >= 0) & pressed & (work - d[offset] >= self.emin)).nonzero()[0]
-            sides.append(2 * rows + side)
-        row, side = np.divmod(np.sort(np.concatenate(sides)), 2)   # a few sides, in order
-        on_b = side.astype(bool)
+            counted[side::2] = (slot[ids] >= 0) & pressed & (work - d[offset] >= self.emin)
+        row, on_b = np.divmod(counted.nonzero()[0], 2)                  # a few sides
+        on_b = on_b.astype(bool)
         places = slot[np.where(on_b, table.b[row], table.a[row])].tolist()
         shares = np.where(on_b, d[SHARE_B, row], d[SHARE_A, row]).tolist()
         totals = [0.0] * len(bodies)
-        stored, rows = self.law.stored, row.tolist()
-        for place, share, phys, overlap_now in zip(places, shares, take(table.physs, rows),
+        stored = self.law.stored
+        for place, share, phys, overlap_now in zip(places, shares, take(table.physs, row.tolist()),
                                                    overlap[row].tolist()):
             totals[place] += share * stored(phys.kno, overlap_now)
         return totals
