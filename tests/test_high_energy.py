@@ -148,6 +148,51 @@ def test_opening_slack_pairs_sleep_and_a_returning_pair_pushes_within_the_tolera
 
 
 @pytest.mark.yade
+def test_while_every_zeroed_pair_sleeps_the_runner_waits_and_the_run_is_the_same(scene,
+                                                                                  monkeypatch):
+    """Three pairs of overlapping fragments (zeroed) drift apart at different speeds and sleep
+    (zeroing_tolerance 0.05): while none is awake the zeroing's runner is not called until the
+    first is due (its calls are the steps at which a pair was visited), and every body moves as
+    with the runner called every step, bit for bit."""
+    from yade import O, utils
+    from yadebreak import engine, scenes
+    from yadebreak.engine.parts import protocol
+    from yadebreak.engine.zeroing import OverlapZeroing
+
+    def run():
+        engine.forget()
+        O.reset()
+        ip2, _ = engine.add_materials({"ore": "copper_ore"})
+        r, ids = 1e-3, []
+        for k, v in enumerate((0.3, 0.5, 0.8)):
+            a = O.bodies.append(utils.sphere((0, 10 * r * k, 0), r, material="ore"))
+            b = O.bodies.append(utils.sphere((1.6 * r, 10 * r * k, 0), r, material="ore"))
+            O.bodies[a].state.vel, O.bodies[b].state.vel = (-v, 0, 0), (v, 0, 0)
+            ids.append((a, b))
+        O.engines = scenes.hertz_engines(ip2)
+        brk = engine.attach({"ore": "copper_ore"}, zeroing_tolerance=0.05, dummies="ledger")
+        for a, b in ids:
+            brk.bodies[a].fracture_energy = brk.bodies[b].fracture_energy = 1e9
+            brk.zeroing.zero_pair(a, b, 0.4 * r, created=False)
+        brk.zeroing.wake()
+        states, all_asleep, visited = [], 0, set()
+        for _ in range(600):
+            engine.run_steps(1)
+            all_asleep += not brk.zeroing.awake and bool(brk.zeroing.asleep)
+            visited.update(z.seen_iter for z in brk.zeroing.pairs.values())
+            states.append(repr([tuple(b.state.pos) + tuple(b.state.vel) for b in O.bodies]))
+        calls = protocol.runs("breakage_zero", brk.zeroing.engine_label)
+        return states, all_asleep, len(visited), calls
+
+    waiting, asleep_steps, visits, calls = run()
+    monkeypatch.setattr(OverlapZeroing, "_visit_every", lambda self, steps: None)
+    every_step, _, _, calls_every_step = run()
+    assert waiting == every_step
+    assert asleep_steps > 500 and calls_every_step == 600
+    assert calls == visits < 600 // 10
+
+
+@pytest.mark.yade
 def test_one_scene_is_the_run_it_always_was(scene, tmp_path):
     """single_impacts with every particle in one scene gives what impact_scene, run_until_rebound
     and breakage_result gave (the same seed: the same run), event for event."""

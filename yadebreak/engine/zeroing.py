@@ -13,6 +13,10 @@ error is where a pair that turns round while asleep closes again without force: 
 zero raised to the overlap it then has, so that it pushes from there on and never with an overlap
 no force resisted (that would create energy); it pushes at most `tolerance` of its overlap later
 than with a visit every step (tolerance 0), and never harder.
+
+While every pair sleeps, the runner sleeps too, until the first pair is due: YADE does the
+waiting, where a call of the runner would cost more than its visits (in a cascade's tail, tens
+of thousands of steps with no pair awake: about 20 us a step).
 """
 from __future__ import annotations
 
@@ -54,6 +58,8 @@ class OverlapZeroing:
         self._loaded_depth = {}                  # wall, facet pair -> overlap (m) when saved
         self._changes = set()                    # pairs zeroed, dropped, asleep or woken
         #                                          since take_changes() (None: not kept)
+        self._period = None                      # the runner's period as last set (None:
+        #                                          not known: restored)
 
     def __bool__(self):
         return bool(self.pairs)
@@ -116,8 +122,15 @@ class OverlapZeroing:
         return z.artificial if z else 0.0
 
     def wake(self):
+        """Pairs were zeroed: visit every step from the next on."""
         if self.pairs:
+            self._visit_every(1)
             protocol.wake(self.engine_label)
+
+    def _visit_every(self, steps):
+        if steps != self._period:
+            self._period = steps
+            protocol.set_period(self.engine_label, steps)
 
     def apply(self):
         """Before the InteractionLoop: scale kno, kso of every zeroed pair awake (sphere pairs
@@ -183,6 +196,10 @@ class OverlapZeroing:
             self.awake.discard(key)
             self.asleep.add(key)
             self._wake_at.setdefault(when, []).append(key)
+        # every pair asleep: the next visit is when the first wakes (entries of pairs dropped
+        # meanwhile may make it earlier: a visit that finds nothing to do)
+        self._visit_every(max(1, min(self._wake_at) - now) if not self.awake and self._wake_at
+                          else 1)
 
     def _wake(self, now):
         """The pairs due now are awake again (pairs dropped while asleep are gone); returns them
