@@ -80,7 +80,8 @@ CASES = {
 }
 
 #: summary keys that measure the machine, not the model
-WALL_KEYS = {"runtime_s", "wall_time_read_s", "wall_time_replace_s", "steps_wall_s"}
+WALL_KEYS = {"runtime_s", "wall_time_read_s", "wall_time_replace_s", "steps_wall_s",
+             "scenes_wall_s", "yade_engines_s"}
 #: summary fields fixed before the run starts (inputs and the model's values), by their last name
 SETUP = {"material", "size", "rings", "layers", "bed_packing", "bed_height", "bed_settling",
          "particle_particle", "particle_steel", "energy", "ball_speed", "seed", "particles",

@@ -8,12 +8,33 @@ import yade.wrapper as wrapper  # noqa: E402
 from yade import Matrix3, O, Quaternion, Vector3, geom, utils  # noqa: E402
 
 __all__ = ["Matrix3", "O", "Quaternion", "Vector3", "close_remote_access", "current_scene", "extend_match_makers",
-           "find_engine", "geom", "scene_folder", "table_row", "utils", "wrapper"]
+           "engine_time", "find_engine", "geom", "scene_folder", "table_row", "utils", "wrapper"]
 
 
 def find_engine(label):
     """The engine of O.engines with this label, or None."""
     return next((e for e in O.engines if getattr(e, "label", "") == label), None)
+
+
+class engine_time:
+    """The time YADE's own engines take in a block, as YADE times them (O.timingEnabled: on for
+    the block, then as it was), yadebreak's runners (PyRunners) left out; O.engines is set before
+    the block. `with engine_time() as t: O.run(...)`, then t.seconds (s)."""
+
+    def __enter__(self):
+        self._was, self.seconds = O.timingEnabled, 0.0
+        self._before = self._own()
+        O.timingEnabled = True
+        return self
+
+    def __exit__(self, *exc):
+        self.seconds = 1e-9 * (self._own() - self._before)
+        O.timingEnabled = self._was
+        return False
+
+    @staticmethod
+    def _own():
+        return sum(e.execTime for e in O.engines if not isinstance(e, wrapper.PyRunner))
 
 
 def table_row(defaults):

@@ -87,7 +87,9 @@ class ImpactTally:
     spheres in the scene as they are (no fines: the paper's Fig. 13); masses (kg) of the scenes at
     their start and end; scene_t10: [broken mass, mass passing size / 10] (kg) of each scene that
     broke (scenes are independently seeded: their scatter is t10's standard error);
-    scene_wall_s: the wall time (s) of the scenes added up, wherever each ran."""
+    scene_wall_s: the wall time (s) of the scenes added up, wherever each ran; yade_engines_s: of
+    it, the time YADE's own engines took (timed by YADE; the rest is yadebreak's runners and the
+    scenes' building and checks)."""
     size: float
     particles: int = 0
     first: list = field(default_factory=list)
@@ -103,6 +105,7 @@ class ImpactTally:
     scenes_at_step_limit: int = 0
     scene_t10: list = field(default_factory=list)
     scene_wall_s: float = 0.0
+    yade_engines_s: float = 0.0
 
     def __post_init__(self):
         if self.progeny_mass is None:
@@ -136,7 +139,7 @@ class ImpactTally:
     def merge(self, other):
         """Add another tally of particles of the same size (another process's scenes)."""
         for name in ("particles", "breakage_events", "initial_mass", "final_mass", "scenes",
-                     "steps", "scenes_at_step_limit", "scene_wall_s"):
+                     "steps", "scenes_at_step_limit", "scene_wall_s", "yade_engines_s"):
             setattr(self, name, getattr(self, name) + getattr(other, name))
         self.first += other.first
         self.e_cum_intact += other.e_cum_intact

@@ -89,10 +89,13 @@ def _impacts_at(args, mat, target, k, energy, out, start):
     result.update({
         "speed": speed, "half_v_squared": energy, "steps": tally.steps, "scenes": tally.scenes,
         "scenes_at_step_limit": tally.scenes_at_step_limit,
+        "scenes_wall_s": tally.scene_wall_s, "yade_engines_s": tally.yade_engines_s,
         "mean_specific_energy_measured": (float(np.mean([e["specific_energy"] / share
                                                          for e in intact])) if intact else None),
         "mass_relative_error": tally.mass_relative_error})
-    progress(f"{reports.result_line(result)}, {tally.steps} steps, {time.time() - start:.1f} s")
+    progress(f"{reports.result_line(result)}, {tally.steps} steps, {time.time() - start:.1f} s "
+             f"(the scenes {tally.scene_wall_s:.1f} s, YADE's own engines "
+             f"{tally.yade_engines_s:.1f} s of them)")
     return brk, result
 
 

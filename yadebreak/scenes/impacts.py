@@ -15,7 +15,7 @@ from yadebreak.engine import add_materials, attach, run_steps
 from yadebreak.engine.parts.rolling import install_rolling
 from yadebreak.engine.cells_replacement import body_kinetic_energy
 from yadebreak.scenes.polyhedra import volumetric_impact_scene
-from yadebreak.adapter.yade_api import O, utils, wrapper as _w
+from yadebreak.adapter.yade_api import O, engine_time, utils, wrapper as _w
 from yadebreak.process.files import append_whole
 from yadebreak.process.signals import stop_point, stop_points
 
@@ -163,7 +163,8 @@ def run_scenes(spec, which, event_log=None, on_scene=None, watch=None):
                 spec["material"], spec["size"], spec["specific_energy"], counts[k], seed=seed,
                 event_log=log_here, **spec["options"])
             initial_mass = brk.total_mass()
-            ran, limited = run_drop_weight(brk, ids, strikers, spec["max_time"])
+            with engine_time() as yade:
+                ran, limited = run_drop_weight(brk, ids, strikers, spec["max_time"])
             brk.finish()
         else:
             build = (volumetric_impact_scene if spec.get("shape") == "polyhedra"
@@ -173,9 +174,10 @@ def run_scenes(spec, which, event_log=None, on_scene=None, watch=None):
                              **spec["options"])
             initial_mass = brk.total_mass()
             watcher = watch(k, brk) if watch is not None else None
-            ran = run_until_rebound(ids, max_steps=spec["max_steps"], brk=brk,
-                                    wait_for_arrivals=spec.get("wait_for_arrivals", False),
-                                    on_check=watcher)
+            with engine_time() as yade:
+                ran = run_until_rebound(ids, max_steps=spec["max_steps"], brk=brk,
+                                        wait_for_arrivals=spec.get("wait_for_arrivals", False),
+                                        on_check=watcher)
             if watcher is not None:
                 watcher.close()
             limited = ran >= spec["max_steps"]
@@ -183,6 +185,7 @@ def run_scenes(spec, which, event_log=None, on_scene=None, watch=None):
         tally.scenes_at_step_limit += int(limited)
         tally.add(brk, ids, initial_mass)
         tally.scene_wall_s += time.perf_counter() - began
+        tally.yade_engines_s += yade.seconds
         if log is not None:
             append_whole(log, "".join(json.dumps({"scene": k, **e}) + "\n" for e in brk.events))
             brk.close()                       # the scene's log file, merged

@@ -174,7 +174,8 @@ class Runner:
         # wall_s: the scenes' own (worker seconds), whichever process ran them and whatever ran
         # beside them
         result.update(steps=tally.steps, scenes_at_step_limit=tally.scenes_at_step_limit,
-                      wall_s=tally.scene_wall_s, material=mat.name, size=run.size,
+                      wall_s=tally.scene_wall_s, yade_engines_s=tally.yade_engines_s,
+                      material=mat.name, size=run.size,
                       options=run.options, seed=run.seed, test=run.test)
         self.results[run.key(energy)] = result
         progress(f"{mat.name} {1e3 * run.size:g} mm {run.test} "
