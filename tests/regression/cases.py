@@ -54,6 +54,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))   # tests/: run as a script too
+from wall_times import WALL_KEYS  # noqa: E402
+
 ROOT = Path(__file__).resolve().parent.parent.parent
 BASELINE = Path(__file__).resolve().parent / "baseline"
 
@@ -79,9 +82,6 @@ CASES = {
                                             "--particles", "30"]),
 }
 
-#: summary keys that measure the machine, not the model
-WALL_KEYS = {"runtime_s", "wall_time_read_s", "wall_time_replace_s", "steps_wall_s",
-             "scenes_wall_s", "yade_engines_s"}
 #: summary fields fixed before the run starts (inputs and the model's values), by their last name
 SETUP = {"material", "size", "rings", "layers", "bed_packing", "bed_height", "bed_settling",
          "particle_particle", "particle_steel", "energy", "ball_speed", "seed", "particles",
