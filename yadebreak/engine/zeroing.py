@@ -29,14 +29,16 @@ _NO_FORCE = Vector3(0.0, 0.0, 0.0)
 
 
 class ZeroedOverlap:
-    """One pair's artificial overlap (m), its stiffnesses before scaling, and its overlap (m) at
-    the step of its last visit (-1: not visited yet)."""
+    """One pair's artificial overlap (m), its stiffnesses before scaling, its overlap (m) at the
+    step of its last visit (-1: not visited yet), and the YADE objects a visit reads (None: not
+    found yet)."""
 
-    __slots__ = ("artificial", "kno0", "kso0", "seen_overlap", "seen_iter")
+    __slots__ = ("artificial", "kno0", "kso0", "seen_overlap", "seen_iter", "objects")
 
     def __init__(self, artificial, kno0, kso0):
         self.artificial, self.kno0, self.kso0 = artificial, kno0, kso0
         self.seen_overlap, self.seen_iter = 0.0, -1
+        self.objects = None
 
     def saved(self):
         return [self.artificial, self.kno0, self.kso0]
@@ -51,10 +53,10 @@ class OverlapZeroing:
         self.tolerance = tolerance               # see the module's docstring
         self.pairs = {}                          # (id_a, id_b), id_a < id_b -> ZeroedOverlap
         self.by_body = {}                        # body -> its zeroed pairs
-        self.awake = set()                       # pairs visited at every step
+        self.awake = {}                          # pairs visited at every step -> their
+        #                                          ZeroedOverlap (a visit looks nothing up)
         self.asleep = set()                      # slack pairs not visited until they wake
         self._wake_at = {}                       # step -> pairs that wake then
-        self._cache = {}                         # pair -> YADE objects read every step
         self._loaded_depth = {}                  # wall, facet pair -> overlap (m) when saved
         self._changes = set()                    # pairs zeroed, dropped, asleep or woken
         #                                          since take_changes() (None: not kept)
@@ -81,7 +83,7 @@ class OverlapZeroing:
     def _register(self, key, zero):
         self._changed(key)
         self.pairs[key] = zero
-        self.awake.add(key)
+        self.awake[key] = zero
         for i in key:
             self.by_body.setdefault(i, set()).add(key)
 
@@ -92,8 +94,7 @@ class OverlapZeroing:
     def _drop(self, key):
         self._changed(key)
         self.pairs.pop(key, None)
-        self._cache.pop(key, None)
-        self.awake.discard(key)
+        self.awake.pop(key, None)
         self.asleep.discard(key)                 # its entry in _wake_at is skipped when due
         for i in key:
             pairs = self.by_body.get(i)
@@ -140,13 +141,12 @@ class OverlapZeroing:
             return
         now = O.iter
         woken = self._wake(now)
-        cache, pairs, tolerance = self._cache, self.pairs, self.tolerance
+        tolerance = self.tolerance
         done, sleep = [], []
-        for key in self.awake:
-            z = pairs[key]
-            c = cache.get(key)
+        for key, z in self.awake.items():
+            c = z.objects
             if c is None:
-                c = self._objects(key)
+                c = z.objects = self._objects(key)
                 if c is None:
                     done.append(key)
                     continue
@@ -193,7 +193,7 @@ class OverlapZeroing:
             self._drop(key)
         for key, when in sleep:
             self._changed(key)
-            self.awake.discard(key)
+            del self.awake[key]
             self.asleep.add(key)
             self._wake_at.setdefault(when, []).append(key)
         # every pair asleep: the next visit is when the first wakes (entries of pairs dropped
@@ -210,7 +210,7 @@ class OverlapZeroing:
                 if key in self.asleep:
                     self._changed(key)
                     self.asleep.discard(key)
-                    self.awake.add(key)
+                    self.awake[key] = self.pairs[key]
                     woken = woken or set()
                     woken.add(key)
         return woken
@@ -235,7 +235,6 @@ class OverlapZeroing:
         else:                                    # facets: the law's last overlap
             sphere = ba if isinstance(ba.shape, wrapper.Sphere) else bb
             c = (ba.state, bb.state, 0.0, inter.phys, inter.geom, 2.0 * sphere.shape.radius)
-        self._cache[key] = c
         return c
 
     def to_list(self):
@@ -267,6 +266,6 @@ class OverlapZeroing:
                 if len(values) > 6 and values[6] is not None:
                     self._loaded_depth[(a, b)] = values[6]
                 if wake >= 0:
-                    self.awake.discard((a, b))
+                    del self.awake[(a, b)]
                     self.asleep.add((a, b))
                     self._wake_at.setdefault(wake, []).append((a, b))
