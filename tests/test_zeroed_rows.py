@@ -13,11 +13,12 @@ def _full(a, b, zeroed, asleep):
 
 
 def _random_rows(rng, n, bodies=60):
-    pairs = set()
+    """n rows of distinct pairs (YADE keeps one interaction per pair), either id first."""
+    pairs = {}
     while len(pairs) < n:
         i, j = rng.choice(bodies, 2, replace=False).tolist()
-        pairs.add((i, j))
-    a, b = np.array(sorted(pairs), np.int64).T          # YADE's order: either id first
+        pairs.setdefault((min(i, j), max(i, j)), (i, j))
+    a, b = np.array(sorted(pairs.values()), np.int64).T
     return a, b
 
 

@@ -11,9 +11,9 @@ import numpy as np
 
 from yadebreak.engine.contacts.law import HertzMindlinWork, own_share, total_work
 from yadebreak.engine.contacts.loading import Loading, StrongestContacts
-from yadebreak.engine.contacts.table import (OVERLAP, OVERLAP_BEFORE, FORCE, SHEAR_DISP,
-                                             SHEAR_FORCE, TIME_BEFORE, TIME_READ, fresh_row,
-                                             take)
+from yadebreak.engine.contacts.table import (OFFSETS, OVERLAP, OVERLAP_BEFORE, FORCE, SHARES,
+                                             SHEAR_DISP, SHEAR_FORCE, TIME_BEFORE, TIME_READ,
+                                             fresh_row, take)
 from yadebreak.engine.contacts.zeroed_rows import ZeroedRows
 
 _law = HertzMindlinWork
@@ -43,6 +43,7 @@ class ArrayRead:
                 flags.forget()
             else:
                 flags.update(table.pairs(), zeroed, asleep, zeroing_changes)
+        incomplete = table.incomplete          # rows restored from a save, found now
         fresh, restored, delta = self._screen(interactions, bodies, mask, counts, now, flags,
                                               zeroed, asleep)
         pairs = table.pairs() if (reader.inherited or asleep or zeroed) else None
@@ -51,9 +52,14 @@ class ArrayRead:
         if flags is not None:
             in_zeroed, resting = flags.update(pairs, zeroed, asleep, set())
             if asleep:
-                update = ~(resting & ~fresh & ~restored)
+                idle = resting                 # (not made of masks that select no row)
+                if fresh is not None:
+                    idle = idle & ~fresh
+                if incomplete:
+                    idle = idle & ~restored
+                update = ~idle
         force, us, fs = self._forces(update)
-        if reader.inherited and fresh.any():
+        if reader.inherited and fresh is not None:
             self._start_here(fresh & pairs.among(reader.inherited), delta, force, us, fs)
         hertz = ~in_zeroed if zeroed else None
         worked = self._work(delta, force, update, hertz, now, interval)
@@ -61,7 +67,7 @@ class ArrayRead:
             self._shear_work(us, fs, update)
         table.by_body = None
         table.resting = None if update is None else ~update
-        return self._loading(mask[table.a], mask[table.b], worked)
+        return self._loading(mask[table.sides()], worked)
 
     def _forces(self, update):
         """The normal force (N) of each row, and with cs > 0 its shear displacement (m) and
@@ -117,8 +123,8 @@ class ArrayRead:
         The rows of zeroed pairs asleep (`flags`, a ZeroedRows, or None) are not read: they are
         slack, and nothing uses their overlap; one the law erased since is found missing by its
         bodies' count. `flags` follows the rows (of the pairs `zeroed`, `asleep`).
-        Returns masks of the fresh rows and of rows restored from a save, and the overlaps (the
-        last read's for the rows asleep)."""
+        Returns masks of the fresh rows (None: none) and of rows restored from a save, and the
+        overlaps (the last read's for the rows asleep)."""
         table, erased = self.table, self.reader.erased_bodies
         restored = (self._find_restored(interactions, bodies) if table.incomplete
                     else np.zeros(len(table), bool))
@@ -144,7 +150,7 @@ class ArrayRead:
             delta, restored = delta[rows], restored[rows]
             if flags is not None:
                 flags.keep(rows)
-        have = np.bincount(np.concatenate((table.a, table.b)), minlength=len(mask))
+        have = table.sides_per_body(len(mask))
         changed = (mask & (have != np.asarray(counts(), np.int64))).nonzero()[0]
         fresh = None
         if len(changed):
@@ -165,7 +171,7 @@ class ArrayRead:
                                  asleep)
         if flags is not None:
             flags.pairs = table.pairs()
-        return (np.zeros(len(table), bool) if fresh is None else fresh), restored, delta
+        return fresh, restored, delta
 
     def _rescan(self, interactions, bodies, changed, now):
         """Rows of the bodies `changed` from YADE's own lists: rows not in them go, interactions
@@ -271,29 +277,22 @@ class ArrayRead:
         np.copyto(table.data[SHEAR_DISP], us, where=where)
         np.copyto(table.data[SHEAR_FORCE], fs, where=where)
 
-    def _loading(self, in_a, in_b, worked):
+    def _loading(self, in_sides, worked):
         """Each tracked body's Ek': the sum, over its contacts whose own work holds at least
-        emin, of its share of that work; its strongest such contact; whether one worked."""
+        emin, of its share of that work; its strongest such contact; whether one worked.
+        `in_sides`: whether each side of each contact (a over b) is a tracked body's."""
         table, reader = self.table, self.reader
         total = total_work(table.work, table.shear_work, reader.cs)
-        # the two sides of each contact in YADE's order, a before b: sums in the order a loop over
-        # the contacts makes them
-        n = len(total)
-        body, counted, share = np.empty(2 * n, np.int64), np.empty(2 * n, bool), np.empty(2 * n)
-        body[0::2], body[1::2] = table.a, table.b
-        counted[0::2], share[0::2] = own_share(total, table.offset_a, table.share_a, reader.emin)
-        counted[1::2], share[1::2] = own_share(total, table.offset_b, table.share_b, reader.emin)
-        counted[0::2] &= in_a
-        counted[1::2] &= in_b
-        grew = set(table.a[in_a & worked].tolist())
-        grew.update(table.b[in_b & worked].tolist())
-        sides = counted.nonzero()[0]
-        if not len(sides):
+        data, ids_of = table.data, table.sides()
+        counted, share = own_share(total, data[OFFSETS], data[SHARES], reader.emin)
+        counted &= in_sides
+        grew = set(ids_of[in_sides & worked].tolist())
+        # the counted sides contact by contact, a before b (nonzero takes the transpose in its
+        # logical order): sums in the order a loop over the contacts makes them
+        row, side = counted.T.nonzero()
+        if not len(row):
             return Loading(grew=grew)
-        owner, values = body[sides], share[sides]
-        # each body's sum over its sides in their order (bincount adds in the order given)
-        ids = np.bincount(owner).nonzero()[0]
-        sums = np.bincount(owner, weights=values)[ids]
+        owner, values = ids_of[side, row], share[side, row]
         # strongest: the first side of each body with the largest share (a loop's strict >);
         # lexsort is stable: among equal shares the first side comes first
         best = np.lexsort((-values, owner))
@@ -302,12 +301,14 @@ class ArrayRead:
         head[0] = True
         head[1:] = ranked[1:] != ranked[:-1]
         heads = best[head]
+        ids = ranked[head]                               # the bodies, in id order
+        # each body's sum over its sides in their order (bincount adds in the order given)
+        sums = np.bincount(owner, weights=values)[ids]
         heads = heads[values[heads] > 0.0]
         # body -> (share, row, sign, partner), built in C: a cloud has hundreds of bodies
-        row, side = np.divmod(sides[heads], 2)
-        b_side = side.astype(bool)
+        row, side = row[heads], side[heads]
         found = dict(zip(owner[heads].tolist(), zip(
-            values[heads].tolist(), row.tolist(), np.where(b_side, -1.0, 1.0).tolist(),
-            np.where(b_side, table.a[row], table.b[row]).tolist())))
+            values[heads].tolist(), row.tolist(), (1.0 - 2.0 * side).tolist(),
+            ids_of[::-1][side, row].tolist())))
         return Loading(dict(zip(ids.tolist(), sums.tolist())),
                        StrongestContacts(found, table.geoms), grew)

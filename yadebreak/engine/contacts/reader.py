@@ -22,8 +22,9 @@ from yadebreak.engine.contacts.arrays import ArrayRead
 from yadebreak.engine.contacts.each import read_each
 from yadebreak.engine.contacts.law import HertzMindlinWork, total_work
 from yadebreak.engine.contacts.volumetric import held_share, held_total
-from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OVERLAP, SHARE_A, SHARE_B,
-                                             SHEAR_WORK, WORK, ContactTable, take)
+from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OFFSETS, OVERLAP, SHARE_A,
+                                             SHARE_B, SHARES, SHEAR_WORK, WORK, ContactTable,
+                                             take)
 
 #: while the rows are at most this many a read goes contact by contact on Python scalars, beyond
 #: with numpy: measured, the scalar path costs about 1.7 us per contact, the numpy one about
@@ -110,18 +111,16 @@ class ContactReader:
         pressed = overlap > 0.0
         if table.resting is not None:
             pressed &= ~table.resting   # asleep zeroed pairs: slack, kno 0, nothing held
-        slot = np.full(max(int(table.a.max(initial=0)), int(table.b.max(initial=0)),
-                           max(bodies)) + 1, -1, np.int64)
+        ids_of = table.sides()
+        slot = np.full(max(int(ids_of.max(initial=0)), max(bodies)) + 1, -1, np.int64)
         slot[bodies] = np.arange(len(bodies))     # body id -> its place in `bodies`
-        # the counted sides of the asked bodies, each contact's a before its b (as arrays.py
-        # lays them out): in the order of each body's rows
-        counted = np.empty(2 * len(table), bool)
-        for side, ids, offset in ((0, table.a, OFFSET_A), (1, table.b, OFFSET_B)):
-            counted[side::2] = (slot[ids] >= 0) & pressed & (work - d[offset] >= self.emin)
-        row, on_b = np.divmod(counted.nonzero()[0], 2)                  # a few sides
-        on_b = on_b.astype(bool)
-        places = slot[np.where(on_b, table.b[row], table.a[row])].tolist()
-        shares = np.where(on_b, d[SHARE_B, row], d[SHARE_A, row]).tolist()
+        place = slot[ids_of]                      # of each side, a over b (-1: not asked)
+        counted = (place >= 0) & pressed & (work - d[OFFSETS] >= self.emin)
+        # the counted sides of the asked bodies (a few), each contact's a before its b (as
+        # arrays.py takes them): in the order of each body's rows
+        row, side = counted.T.nonzero()
+        places = place[side, row].tolist()
+        shares = d[SHARES][side, row].tolist()
         totals = [0.0] * len(bodies)
         stored = self.law.stored
         for place, share, phys, overlap_now in zip(places, shares, take(table.physs, row.tolist()),

@@ -21,6 +21,8 @@ FIELDS = ("overlap", "force", "work", "offset_a", "offset_b", "share_a", "share_
 
 (OVERLAP, FORCE, WORK, OFFSET_A, OFFSET_B, SHARE_A, SHARE_B, SHEAR_DISP, SHEAR_FORCE,
  SHEAR_WORK, OVERLAP_BEFORE, TIME_BEFORE, TIME_READ) = range(len(FIELDS))
+#: the rows of the block with both sides' offsets and shares, a over b (as ContactTable.sides)
+OFFSETS, SHARES = slice(OFFSET_A, OFFSET_B + 1), slice(SHARE_A, SHARE_B + 1)
 
 
 def pair_codes(id1, id2):
@@ -76,7 +78,7 @@ class ContactTable:
         self.geoms, self.physs = geoms, physs
         self.by_body = by_body
         self.index = index
-        self._pairs = None
+        self._pairs = self._sides = self._per_body = None
         #: the rows the last numpy read left as they were (zeroed pairs asleep: slack, kno 0);
         #: None: every row was read
         self.resting = None
@@ -133,6 +135,19 @@ class ContactTable:
             self._pairs = RowPairs(self.a, self.b)
         return self._pairs
 
+    def sides(self):
+        """The rows' body ids, a over b (2 x contacts), kept until the rows change."""
+        if self._sides is None:
+            self._sides = np.stack((self.a, self.b))
+        return self._sides
+
+    def sides_per_body(self, n):
+        """How many rows each body id below n is a side of (n at least every id + 1), kept until
+        the rows change."""
+        if self._per_body is None or len(self._per_body) != n:
+            self._per_body = np.bincount(self.sides().ravel(), minlength=n)
+        return self._per_body
+
     def rows_of(self, body):
         """[(row, side: 0 for a, 1 for b)] of a body's contacts at the last read, in YADE's order
         (of the tracked bodies' sides, from the scalar read; of every side, from the numpy read:
@@ -179,7 +194,7 @@ class RowPairs:
 
     def __init__(self, a, b):
         self.lo, self.hi = np.minimum(a, b), np.maximum(a, b)
-        self._codes = self._tuples = None
+        self._codes = self._tuples = self._rows = None
 
     def __len__(self):
         return len(self.lo)
@@ -206,6 +221,14 @@ class RowPairs:
         known = np.sort(pair_codes(ab[0::2], ab[1::2]))
         pos = np.minimum(np.searchsorted(known, self._codes), len(known) - 1)
         return known[pos] == self._codes
+
+    def rows_of(self, pairs):
+        """[(row, pair)] of the pairs of `pairs` that are rows (each pair is one row at most): a
+        look-up per pair, for the few pairs the zeroing changes between two reads."""
+        if self._rows is None:
+            self._rows = dict(zip(self._tuple_list(), range(len(self.lo))))
+        get = self._rows.get
+        return [(k, key) for key, k in zip(pairs, map(get, pairs)) if k is not None]
 
     def _tuple_list(self):
         if self._tuples is None:

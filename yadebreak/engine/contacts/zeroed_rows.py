@@ -20,12 +20,9 @@ class ZeroedRows:
         looked up again when they describe the same rows and `changed` is known (a set of
         (smaller id, larger id)), else every row looked up. Returns (zeroed, asleep)."""
         if self.pairs is pairs and changed is not None:
-            if changed:
-                rows = pairs.among(changed).nonzero()[0]
-                keys = zip(pairs.lo[rows].tolist(), pairs.hi[rows].tolist())
-                for k, key in zip(rows.tolist(), keys):
-                    self.zeroed[k] = key in zeroed
-                    self.asleep[k] = key in asleep
+            for k, key in pairs.rows_of(changed):
+                self.zeroed[k] = key in zeroed
+                self.asleep[k] = key in asleep
         else:
             n = len(pairs)
             self.zeroed = pairs.among(zeroed) if zeroed else np.zeros(n, bool)
