@@ -149,17 +149,19 @@ class Judge:
         n = len(candidates)
         ids = np.fromiter(candidates, np.int64, n)
         known = np.fromiter(map(self.state.tracked.__contains__, candidates), bool, n)
-        paused = (known & (c["pause_until"][ids] > now_iter) if self.pausing
-                  else np.zeros(n, bool))
-        active = known & ~paused
+        all_known = bool(known.all())
+        paused = known & (c["pause_until"][ids] > now_iter) if self.pausing else None
+        # (masks that can select no body, with no pausing or every candidate tracked, are not
+        # made: numpy's cost per call is most of a read's judging)
+        active = known if paused is None else known & ~paused
+        every = all_known if paused is None else bool(active.all())
         ek = np.fromiter(map(loading.energy.get, candidates, repeat(0.0, n)), float, n)
         if self.carried:
             ek = ek + c["carried"][ids]
         if self.energy_factor != 1.0:
             ek = np.where(c["generation"][ids] > 0, ek * self.energy_factor, ek)
         specific = ek / c["mass"][ids]
-        v = judge_all(self.criterion_of, self.state.table, ids, active, ek, specific,
-                      bool(active.all()))
+        v = judge_all(self.criterion_of, self.state.table, ids, active, ek, specific, every)
         limits = None
         if fast and v.rising.any():
             r = v.rising
@@ -174,16 +176,23 @@ class Judge:
             ek = np.where(breaks, np.maximum(ek, event_max), ek)
             v.jump = np.where(crossed, 0.0, v.jump)
         grows = active & ~breaks & (ek > event_max)
-        c["specific_energy"][ids[active]] = specific[active]
+        if every:
+            c["specific_energy"][ids] = specific
+        else:
+            c["specific_energy"][ids[active]] = specific[active]
         c["event_max"][ids[grows]] = ek[grows]
         c["event_partner"][ids[grows]] = list(map(loading.strongest.partner,
                                                   ids[grows].tolist()))
-        c["event_max"][ids[paused]] = 0.0
-        c["specific_energy"][ids[paused]] = 0.0
         need = np.full(n, NOTHING, np.int8)
-        for what, mask in ((CLOSE_IF_UNLOADED, active & (event_max > 0.0)), (OPEN, grows),
-                           (BREAK, active & breaks), (PAUSE, paused), (FORGET, ~known)):
-            need[mask] = what
+        need[active & (event_max > 0.0)] = CLOSE_IF_UNLOADED
+        need[grows] = OPEN
+        need[active & breaks] = BREAK
+        if paused is not None:
+            c["event_max"][ids[paused]] = 0.0
+            c["specific_energy"][ids[paused]] = 0.0
+            need[paused] = PAUSE
+        if not all_known:
+            need[~known] = FORGET
         return Plan(need.tolist(), v.order.tolist(), ek.tolist(), v.jump.tolist(),
                     v.threshold.tolist(), limits)
 
@@ -237,6 +246,7 @@ class Judge:
         table = self.state.table
         c = table.columns
         event_max, mass = float(c["event_max"][bid]), float(c["mass"][bid])
+        energy = float(c["fracture_energy"][bid])
         criterion = self.criterion_of[c["material"][bid]]
         fields = criterion.unload(table, bid)
         if fields is not None:
@@ -245,5 +255,7 @@ class Judge:
         c["event_max"][bid] = c["specific_energy"][bid] = c["carried"][bid] = 0.0
         self.state.open_events.discard(bid)
         self.reader.restart(bid)
-        if fields is not None:
+        if fields is not None and c["fracture_energy"][bid] != energy:
+            # only a change of E moves the read schedule: Ab-T10's unloading keeps E, and a light
+            # touch's E (1 - D) rounds to E
             self.weakened(bid)
