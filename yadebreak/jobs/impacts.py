@@ -8,6 +8,7 @@ drop_weight   a steel striker falls on each particle on an anvil (the paper's DW
 The energies of single impacts and drop-weight tests are independent units (skeleton.run_units:
 --resume 1 keeps those finished); repeated impacts are a Job checkpointed after every impact.
 """
+import contextlib
 import dataclasses
 import json
 import math
@@ -55,18 +56,29 @@ def single(args):
         at = [r["specific_energy"] for r in results if r["scenes_at_step_limit"]]
         return f"scenes stopped at the step limit at {at} J/kg" if at else ""
 
-    brk = skeleton.run_units(
-        args, _energies(args), lambda k, energy: _impacts_at(args, mat, target, k, energy, out,
-                                                             start),
-        write, limited, validate=lambda energy, result: reports.check_breakage_result(
-            result, mat, args.size, float(energy), target, args.particles))
+    with _workers(args) as pool:
+        brk = skeleton.run_units(
+            args, _energies(args), lambda k, energy: _impacts_at(args, mat, target, k, energy,
+                                                                 out, start, pool),
+            write, limited, validate=lambda energy, result: reports.check_breakage_result(
+                result, mat, args.size, float(energy), target, args.particles))
     progress(f"wrote {out / 'summary.json'} and {out / 'single_impact.png'}")
     return brk
 
 
-def _impacts_at(args, mat, target, k, energy, out, start):
-    """The particles fired at `energy` (J/kg) in scenes of --scene-particles: (the last scene's
-    controller, the energy's result)."""
+def _workers(args):
+    """The worker processes of every energy (--jobs above 1 and more than one scene an
+    energy): started once for the run, where a pool per energy would start YADE again each
+    time; a null context otherwise."""
+    scenes_each = math.ceil(args.particles / args.scene_particles)
+    if args.jobs <= 1 or scenes_each <= 1:
+        return contextlib.nullcontext()
+    return scenes.ImpactPool(min(args.jobs, scenes_each))
+
+
+def _impacts_at(args, mat, target, k, energy, out, start, pool=None):
+    """The particles fired at `energy` (J/kg) in scenes of --scene-particles, by the workers
+    `pool` if any: (the last scene's controller, the energy's result)."""
     speed = float(np.sqrt(2 * energy))
     began, said = time.time(), [time.time()]
 
@@ -81,7 +93,7 @@ def _impacts_at(args, mat, target, k, energy, out, start):
     tally, brk = scenes.single_impacts(
         args.material, args.size, speed, args.particles, args.scene_particles, args.seed + k,
         target=args.target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
-        jobs=args.jobs, shape=args.shape, watch=_frames(args, out, energy),
+        jobs=args.jobs, pool=pool, shape=args.shape, watch=_frames(args, out, energy),
         **job_options.attach_options("single_impact", args))
     share = mat.energy_partition(target)
     result = reports.breakage_result_of(tally, mat, energy, target)
