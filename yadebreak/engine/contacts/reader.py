@@ -114,12 +114,12 @@ class ContactReader:
         ids_of = table.sides()
         slot = np.full(max(int(ids_of.max(initial=0)), max(bodies)) + 1, -1, np.int64)
         slot[bodies] = np.arange(len(bodies))     # body id -> its place in `bodies`
-        place = slot[ids_of]                      # of each side, a over b (-1: not asked)
-        counted = (place >= 0) & pressed & (work - d[OFFSETS] >= self.emin)
+        asked = slot[ids_of]                      # of each side, a over b (-1: not asked)
+        counted = (asked >= 0) & pressed & (work - d[OFFSETS] >= self.emin)
         # the counted sides of the asked bodies (a few), each contact's a before its b (as
         # arrays.py takes them): in the order of each body's rows
         row, side = counted.T.nonzero()
-        places = place[side, row].tolist()
+        places = asked[side, row].tolist()
         shares = d[SHARES][side, row].tolist()
         totals = [0.0] * len(bodies)
         stored = self.law.stored
