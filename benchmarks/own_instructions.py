@@ -7,8 +7,9 @@ own functions called from Python, the C library.
 
 Why instructions: on a shared machine the same run's time moves by tens of percent from one run
 to the next, more than a change of a few percent in yadebreak's Python; a count of instructions
-does not move (the runs are deterministic), so two trees compare in one run each. It does not
-see cache misses: time is still the judge of a speed target (docs/performance.md).
+repeats to about 0.1 % (the runs are the same but for Python's string hashing), so two trees
+compare in one run each. It does not see cache misses: time is still the judge of a speed target
+(docs/performance.md).
 
 Cases (issue 45's scenes):
   ab_cloud     the heaviest scene of `scripts/single_impact.py --material ab_t10_ore --size 12mm
