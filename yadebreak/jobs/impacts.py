@@ -67,13 +67,11 @@ def single(args):
 
 
 def _workers(args):
-    """The worker processes of every energy (--jobs above 1 and more than one scene an
-    energy): started once for the run, where a pool per energy would start YADE again each
-    time; a null context otherwise."""
-    scenes_each = math.ceil(args.particles / args.scene_particles)
-    if args.jobs <= 1 or scenes_each <= 1:
-        return contextlib.nullcontext()
-    return scenes.ImpactPool(min(args.jobs, scenes_each))
+    """The worker processes of every energy (scenes.workers_for), started once for the run,
+    where a pool per energy would start YADE again each time; a null context without any."""
+    workers = scenes.workers_for(args.jobs, scenes.scene_counts(args.particles,
+                                                                args.scene_particles))
+    return scenes.ImpactPool(workers) if workers else contextlib.nullcontext()
 
 
 def _impacts_at(args, mat, target, k, energy, out, start, pool=None):

@@ -14,5 +14,6 @@ from yadebreak.scenes.beds import (BALL_DIAMETER, BALL_MASS, bed_impact_scene,  
                    hex_bed_positions, hold_release)
 from yadebreak.scenes.impacts import (drop_weight_scene, drop_weight_spec, hertz_engines,  # noqa: F401
                       impact_again, impact_scene, impact_spec, run_drop_weight, run_scenes,
-                      run_until_rebound, scene_seed, single_impacts)
+                      run_until_rebound, scene_counts, scene_seed, single_impacts,
+                      workers_for)
 from yadebreak.scenes.impact_pool import ImpactPool  # noqa: F401

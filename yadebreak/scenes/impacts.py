@@ -105,9 +105,10 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
                        wait_for_arrivals, shape, **options)
     if pool is not None:
         return pool.collect(pool.submit(spec, event_log), on_scene), None
-    if jobs > 1 and len(spec["counts"]) > 1:
+    workers = workers_for(jobs, spec["counts"])
+    if workers:
         from yadebreak.scenes.impact_pool import ImpactPool
-        with ImpactPool(min(jobs, len(spec["counts"]))) as own:
+        with ImpactPool(workers) as own:
             return own.collect(own.submit(spec, event_log), on_scene), None
     if event_log is not None:
         Path(event_log).write_text("")
@@ -125,7 +126,7 @@ def impact_spec(material, size, speed, particles, per_scene, seed, target="steel
         raise ValueError(f"shape = {shape!r}: accepted {SHAPES}")
     return {"material": str(material), "size": size, "speed": speed, "seed": seed,
             "target": target, "max_steps": max_steps, "options": options,
-            "counts": _scene_counts(particles, per_scene), "wait_for_arrivals": wait_for_arrivals,
+            "counts": scene_counts(particles, per_scene), "wait_for_arrivals": wait_for_arrivals,
             "shape": shape}
 
 
@@ -136,13 +137,19 @@ def drop_weight_spec(material, size, specific_energy, particles, per_scene, seed
     its strikers are done or `max_time` (s) of simulated time (run_drop_weight)."""
     return {"test": "drop_weight", "material": str(material), "size": size,
             "specific_energy": specific_energy, "seed": seed, "max_time": max_time,
-            "options": options, "counts": _scene_counts(particles, per_scene)}
+            "options": options, "counts": scene_counts(particles, per_scene)}
 
 
-def _scene_counts(particles, per_scene):
+def scene_counts(particles, per_scene):
     """The particles of each scene: per_scene each, the rest in the last."""
     return [per_scene] * (particles // per_scene) + ([particles % per_scene]
                                                      if particles % per_scene else [])
+
+
+def workers_for(jobs, counts):
+    """How many worker processes run scenes of `counts` (scene_counts) with --jobs `jobs`: 0,
+    this process, for one scene or jobs <= 1 (a worker would only add YADE's start)."""
+    return min(jobs, len(counts)) if jobs > 1 and len(counts) > 1 else 0
 
 
 def run_scenes(spec, which, event_log=None, on_scene=None, watch=None):
