@@ -54,9 +54,9 @@ def run_case(case, tree):
                                   read_period="every_step")
         scenes.run_scenes(spec, [23])
     else:
+        from yadebreak import engine     # the tree's, before bench_scale puts its own parent first
         sys.path.insert(0, str(Path(tree) / "benchmarks"))
         import bench_scale
-        from yadebreak import engine
         bench_scale.prepare("collisional", 1000, "default")
         engine.run_steps(400)
 
