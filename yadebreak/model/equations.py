@@ -166,6 +166,8 @@ def damage(ratio, gamma):
     than one unit in ln D. Safeguarded Newton on ln D, vectorised; exact to round-off.
     r <= 0 gives 0. r >= 1 is a breakage, not damage: it returns 1.
     """
+    if type(ratio) is float and type(gamma) is float:     # a closing event: np.ndim's
+        return _damage_one(ratio, gamma)                  # dispatch would cost more
     if np.ndim(ratio) == 0 and np.ndim(gamma) == 0:
         return _damage_one(float(ratio), float(gamma))
     ratio, gamma = np.broadcast_arrays(np.asarray(ratio, dtype=float), np.asarray(gamma, dtype=float))

@@ -79,14 +79,18 @@ def read_each(reader, real, bodies, tracked, zeroed, now, interval, asleep, prev
     old_rows, old_geoms, old_physs = table.row_lists(), table.geoms, table.physs
     a_list, b_list, rows, geoms, physs = [], [], [], [], []
     energy, found, grew, by_body = {}, {}, set(), {}
+    # a contact's pair (smaller id, larger id) is looked up only where some pair is zeroed,
+    # asleep or inherited (a scene without fragments has none)
+    paired = bool(zeroed or asleep or inherited)
     for inter in real:
         a, b = inter.id1, inter.id2
         in_a = a in tracked
         in_b = b in tracked
         if not (in_a or in_b):
             continue
-        pair = (a, b) if a < b else (b, a)
-        j = index.get((a, b))
+        pair = ((a, b) if a < b else (b, a)) if paired else None
+        key = (a, b)
+        j = index.get(key)
         update, delta = True, None
         if j is not None:
             geom = old_geoms[j]
@@ -113,7 +117,7 @@ def read_each(reader, real, bodies, tracked, zeroed, now, interval, asleep, prev
         if volumetric:
             worked = volumetric_advance(row, geom, phys, bodies[a].state, bodies[b].state, now)
         else:
-            worked = update and _advance(row, geom, phys, delta, bool(zeroed) and pair in zeroed,
+            worked = update and _advance(row, geom, phys, delta, paired and pair in zeroed,
                                          first_touch, cs, now)
         if worked:
             if in_a:
@@ -121,7 +125,7 @@ def read_each(reader, real, bodies, tracked, zeroed, now, interval, asleep, prev
             if in_b:
                 grew.add(b)
         k = len(rows)
-        new_index[(a, b)] = k
+        new_index[key] = k
         rows.append(row)
         a_list.append(a)
         b_list.append(b)

@@ -90,13 +90,13 @@ class ContactReader:
         if table.is_block:
             return self.stored_shares([body])[0]
         total = 0.0
-        value = table.value
-        for row, side in table.rows_of(body):
-            offset = value(row, OFFSET_B if side else OFFSET_A)
-            overlap = value(row, OVERLAP)
-            if table.total(row, self.cs) - offset >= self.emin and overlap > 0.0:
-                share = value(row, SHARE_B if side else SHARE_A)
-                total += share * self.law.stored(table.physs[row].kno, overlap)
+        rows, physs, cs, emin = table.row_lists(), table.physs, self.cs, self.emin
+        for k, side in table.rows_of(body):
+            row = rows[k]
+            overlap = row[OVERLAP]
+            if (overlap > 0.0 and total_work(row[WORK], row[SHEAR_WORK], cs)
+                    - row[OFFSET_B if side else OFFSET_A] >= emin):
+                total += row[SHARE_B if side else SHARE_A] * self.law.stored(physs[k].kno, overlap)
         return total
 
     def stored_shares(self, bodies):
