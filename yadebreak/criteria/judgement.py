@@ -22,20 +22,20 @@ class Judgement:
     rising: np.ndarray
     rise: np.ndarray
     jump: np.ndarray
-    order: np.ndarray | None = None       # judge_all: each body's criterion.order
+    order: np.ndarray | None = None       # judge_all: each body's criterion.order (None:
+    #                                       one criterion judged them all)
 
 
-def judge_all(criterion_of, table, ids, active, ek, specific, every=False):
+def judge_all(criterion_of, table, ids, active, ek, specific):
     """Every material's criterion on its active bodies among `ids` (vectorised per material);
-    criterion_of[m] is the criterion of material index m; `every`: all bodies are active.
+    criterion_of[m] is the criterion of material index m; `active` a mask of `ids`, None for all.
     Returns a Judgement over all `ids` (inactive rows: no breakage, not rising) with `order`,
-    the criteria's settling order."""
+    the criteria's settling order (None: one criterion judged every body)."""
     n = len(ids)
-    if every and len(criterion_of) == 1:             # one material: no grouping
-        crit = criterion_of[0]
-        j = crit.judge(table, ids, ek, specific)
-        j.order = np.full(n, crit.order, np.int8)
-        return j
+    if len(criterion_of) == 1 and (active is None or active.all()):     # no grouping
+        return criterion_of[0].judge(table, ids, ek, specific)
+    if active is None:
+        active = np.ones(n, bool)
     out = Judgement(breaks=np.zeros(n, bool), level=np.zeros(n), threshold=np.ones(n),
                     rising=np.zeros(n, bool), rise=np.zeros(n), jump=np.zeros(n),
                     order=np.zeros(n, np.int8))

@@ -39,8 +39,10 @@ def steps_allowed(tolerance, threshold, level, rise, interval):
 
 
 class Plan:
-    """A read's decisions: for each candidate its need (codes above), criterion order, Ek' (J),
-    jump and threshold (J/kg); and the steps the loaded bodies allow (a list; fast reads)."""
+    """A read's decisions: for each candidate its need (codes above), criterion order (None: one
+    criterion for all), Ek' (J), jump and threshold (J/kg; lists, or arrays when nothing breaks:
+    they are asked of breaking bodies only); and the steps the loaded bodies allow (a list; fast
+    reads)."""
 
     __slots__ = ("need", "order", "ek", "jump", "threshold", "limits")
 
@@ -62,6 +64,11 @@ class Rules:
 
 def _ignore(*args, **fields):
     return None
+
+
+def _within(mask, active):
+    """`mask` on the active candidates only (`active` None: every candidate is)."""
+    return mask if active is None else mask & active
 
 
 class Judge:
@@ -148,53 +155,60 @@ class Judge:
         c = self.state.table.columns
         n = len(candidates)
         ids = np.fromiter(candidates, np.int64, n)
-        known = np.fromiter(map(self.state.tracked.__contains__, candidates), bool, n)
-        all_known = bool(known.all())
-        paused = known & (c["pause_until"][ids] > now_iter) if self.pausing else None
-        # (masks that can select no body, with no pausing or every candidate tracked, are not
-        # made: numpy's cost per call is most of a read's judging)
-        active = known if paused is None else known & ~paused
-        every = all_known if paused is None else bool(active.all())
+        tracked = self.state.tracked
+        # no mask is made that would select every candidate (all tracked, none paused) or none
+        # (paused): numpy's cost per call is most of a read's judging; `active` None stands for
+        # every candidate
+        known = (None if tracked.issuperset(candidates)
+                 else np.fromiter(map(tracked.__contains__, candidates), bool, n))
+        paused = _within(c["pause_until"][ids] > now_iter, known) if self.pausing else None
+        if paused is not None and not paused.any():
+            paused = None
+        active = known if paused is None else _within(~paused, known)
         ek = np.fromiter(map(loading.energy.get, candidates, repeat(0.0, n)), float, n)
         if self.carried:
             ek = ek + c["carried"][ids]
         if self.energy_factor != 1.0:
             ek = np.where(c["generation"][ids] > 0, ek * self.energy_factor, ek)
         specific = ek / c["mass"][ids]
-        v = judge_all(self.criterion_of, self.state.table, ids, active, ek, specific, every)
+        v = judge_all(self.criterion_of, self.state.table, ids, active, ek, specific)
         limits = None
         if fast and v.rising.any():
             r = v.rising
             limits = steps_allowed(self.fast_tolerance, v.threshold[r], v.level[r], v.rise[r],
                                    interval).tolist()
         event_max = c["event_max"][ids]
-        breaks = v.breaks
+        breaks = v.breaks                                # False where inactive
         if self.at_peak:
-            crossed = active & (breaks | (c["cracked"][ids] > 0))
+            crossed = _within(breaks | (c["cracked"][ids] > 0), active)
             breaks = crossed & (ek <= event_max)         # the event's peak has passed
             c["cracked"][ids[crossed & ~breaks]] = 1     # still loading: the peak is ahead
             ek = np.where(breaks, np.maximum(ek, event_max), ek)
             v.jump = np.where(crossed, 0.0, v.jump)
-        grows = active & ~breaks & (ek > event_max)
-        if every:
+        grows = _within(~breaks & (ek > event_max), active)
+        if active is None:
             c["specific_energy"][ids] = specific
         else:
             c["specific_energy"][ids[active]] = specific[active]
-        c["event_max"][ids[grows]] = ek[grows]
-        c["event_partner"][ids[grows]] = list(map(loading.strongest.partner,
-                                                  ids[grows].tolist()))
+        growing = ids[grows]
+        c["event_max"][growing] = ek[grows]
+        c["event_partner"][growing] = list(map(loading.strongest.partner, growing.tolist()))
         need = np.full(n, NOTHING, np.int8)
-        need[active & (event_max > 0.0)] = CLOSE_IF_UNLOADED
+        need[_within(event_max > 0.0, active)] = CLOSE_IF_UNLOADED
         need[grows] = OPEN
-        need[active & breaks] = BREAK
+        broke = bool(breaks.any())
+        if broke:
+            need[breaks] = BREAK
         if paused is not None:
             c["event_max"][ids[paused]] = 0.0
             c["specific_energy"][ids[paused]] = 0.0
             need[paused] = PAUSE
-        if not all_known:
+        if known is not None:
             need[~known] = FORGET
-        return Plan(need.tolist(), v.order.tolist(), ek.tolist(), v.jump.tolist(),
-                    v.threshold.tolist(), limits)
+        # Ek', jump and threshold are asked of breaking bodies only (settle)
+        return Plan(need.tolist(), None if v.order is None else v.order.tolist(),
+                    ek.tolist() if broke else ek, v.jump.tolist() if broke else v.jump,
+                    v.threshold.tolist() if broke else v.threshold, limits)
 
     def settle(self, candidates, plan, loading):
         """Events open, close or break, body by body in the criteria's order (Tavares bodies,
@@ -202,7 +216,7 @@ class Judge:
         open_events = self.state.open_events
         broken = []
         visit = range(len(candidates))
-        if any(plan.order):
+        if plan.order is not None and any(plan.order):
             visit = sorted(visit, key=plan.order.__getitem__)      # stable
         unloaded = self._unloaded(candidates, plan, loading)
         for k in visit:
