@@ -79,18 +79,14 @@ def read_each(reader, real, bodies, tracked, zeroed, now, interval, asleep, prev
     old_rows, old_geoms, old_physs = table.row_lists(), table.geoms, table.physs
     a_list, b_list, rows, geoms, physs = [], [], [], [], []
     energy, found, grew, by_body = {}, {}, set(), {}
-    # a contact's pair (smaller id, larger id) is looked up only where some pair is zeroed,
-    # asleep or inherited (a scene without fragments has none)
-    paired = bool(zeroed or asleep or inherited)
+    paired = bool(zeroed or asleep or inherited)     # else no contact's pair is looked up
     for inter in real:
         a, b = inter.id1, inter.id2
-        in_a = a in tracked
-        in_b = b in tracked
+        in_a, in_b = a in tracked, b in tracked
         if not (in_a or in_b):
             continue
-        pair = ((a, b) if a < b else (b, a)) if paired else None
-        key = (a, b)
-        j = index.get(key)
+        pair = ((a, b) if a < b else (b, a)) if paired else None   # (smaller id, larger)
+        j = index.get((a, b))
         update, delta = True, None
         if j is not None:
             geom = old_geoms[j]
@@ -125,7 +121,7 @@ def read_each(reader, real, bodies, tracked, zeroed, now, interval, asleep, prev
             if in_b:
                 grew.add(b)
         k = len(rows)
-        new_index[key] = k
+        new_index[(a, b)] = k
         rows.append(row)
         a_list.append(a)
         b_list.append(b)
