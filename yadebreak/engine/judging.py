@@ -40,9 +40,8 @@ def steps_allowed(tolerance, threshold, level, rise, interval):
 
 class Plan:
     """A read's decisions: for each candidate its need (codes above), criterion order (None: one
-    criterion for all), Ek' (J), jump and threshold (J/kg; lists, or arrays when nothing breaks:
-    they are asked of breaking bodies only); and the steps the loaded bodies allow (a list; fast
-    reads)."""
+    criterion for all), Ek' (J), jump and threshold (J/kg; plan_all's as arrays: they are asked
+    of breaking bodies only); and the steps the loaded bodies allow (a list; fast reads)."""
 
     __slots__ = ("need", "order", "ek", "jump", "threshold", "limits")
 
@@ -161,9 +160,11 @@ class Judge:
         # every candidate
         known = (None if tracked.issuperset(candidates)
                  else np.fromiter(map(tracked.__contains__, candidates), bool, n))
-        paused = _within(c["pause_until"][ids] > now_iter, known) if self.pausing else None
-        if paused is not None and not paused.any():
-            paused = None
+        paused = None
+        if self.pausing:
+            paused = _within(c["pause_until"][ids] > now_iter, known)
+            if not paused.any():
+                paused = None
         active = known if paused is None else _within(~paused, known)
         ek = np.fromiter(map(loading.energy.get, candidates, repeat(0.0, n)), float, n)
         if self.carried:
@@ -196,19 +197,16 @@ class Judge:
         need = np.full(n, NOTHING, np.int8)
         need[_within(event_max > 0.0, active)] = CLOSE_IF_UNLOADED
         need[grows] = OPEN
-        broke = bool(breaks.any())
-        if broke:
-            need[breaks] = BREAK
+        need[breaks] = BREAK
         if paused is not None:
             c["event_max"][ids[paused]] = 0.0
             c["specific_energy"][ids[paused]] = 0.0
             need[paused] = PAUSE
         if known is not None:
             need[~known] = FORGET
-        # Ek', jump and threshold are asked of breaking bodies only (settle)
-        return Plan(need.tolist(), None if v.order is None else v.order.tolist(),
-                    ek.tolist() if broke else ek, v.jump.tolist() if broke else v.jump,
-                    v.threshold.tolist() if broke else v.threshold, limits)
+        # Ek', jump and threshold stay arrays: settle asks them of breaking bodies only
+        return Plan(need.tolist(), None if v.order is None else v.order.tolist(), ek, v.jump,
+                    v.threshold, limits)
 
     def settle(self, candidates, plan, loading):
         """Events open, close or break, body by body in the criteria's order (Tavares bodies,
@@ -230,8 +228,9 @@ class Judge:
                 if i in unloaded:
                     self.close_event(i)
             elif what == BREAK:
-                if plan.jump[k] > LATE_JUMP * plan.threshold[k]:
-                    self.warn_jump(i, plan.jump[k], plan.threshold[k], float(plan.ek[k]))
+                jump, threshold = float(plan.jump[k]), float(plan.threshold[k])
+                if jump > LATE_JUMP * threshold:
+                    self.warn_jump(i, jump, threshold, float(plan.ek[k]))
                 broken.append((i, float(plan.ek[k]), loading.strongest.get(i)))
             elif what == PAUSE:
                 # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
