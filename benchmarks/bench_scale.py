@@ -1,7 +1,7 @@
 """Benchmark: the engine's cost at process scale, beside plain YADE.
 
     /usr/bin/python3 benchmarks/bench_scale.py [--quick] [--sizes 1000,10000,100000] [--repeats 3]
-                                               [--mill-only]
+                                               [--mill-only] [--per-step-only]
 
 Two scenes of 5.5 mm copper-ore spheres in a steel box, each built for N bodies:
 - dense: a column on a cubic lattice (each sphere touching its neighbours), under gravity, pressed
@@ -14,7 +14,11 @@ with every contact read every step (read_period="every_step"), first with breaka
 (25 m/s). Then: the cost of one breakage event at each size, the default ball mill in each
 mode (and as the grinding model's spectra run: attach(breakage=False)), attach() at each size,
 and yadebreak's memory per body.
-Prints microseconds per step and ratios measured in this run; --quick runs 1e3 and 1e4 bodies.
+Part 1 also runs a floor: plain YADE with a PyRunner at the default's mean read period that only
+touches each ore contact's overlap and normal force (as on the mill, part 4, but with the time of
+finding the contacts left out): a lower bound of any reader in Python; what the default costs
+above it is yadebreak's own work. Prints microseconds per step and ratios measured in this run;
+--quick runs 1e3 and 1e4 bodies, --per-step-only part 1 alone.
 """
 import argparse
 import gc
@@ -30,6 +34,7 @@ import numpy as np  # noqa: E402
 from yadebreak import engine, scenes  # noqa: E402
 from yadebreak.adapter.yade_api import O, utils, wrapper as _w  # noqa: E402
 from yadebreak.options.table import Config  # noqa: E402
+from yadebreak.engine.parts import protocol  # noqa: E402
 from yadebreak.engine.stepping import smallest_rayleigh_time  # noqa: E402
 
 RADIUS = 2.75e-3
@@ -123,35 +128,55 @@ def steps_for(n):
 
 
 def rate(kind, n, mode, steps, breakable=False, speed=None):
-    """(us per step, real contacts, breakages) over `steps` steps."""
+    """(us per step, real contacts, breakages, attach() s, reads made: None in plain YADE) over
+    `steps` steps."""
     brk, attach_s = prepare(kind, n, mode, breakable, speed)
+    reads = _reads()
     gc.collect()
     t0 = time.perf_counter()
     engine.run_steps(steps)
     elapsed = time.perf_counter() - t0
     broken = len(brk.breakage_events) if brk is not None else 0
-    return 1e6 * elapsed / steps, O.interactions.countReal(), broken, attach_s
+    return (1e6 * elapsed / steps, O.interactions.countReal(), broken, attach_s,
+            None if brk is None else _reads() - reads)
+
+
+def _reads():
+    """The reads the engine (attach()'s default label) has made so far."""
+    return protocol.runs("breakage", "yadebreak")
+
+
+def floor_rate(kind, n, steps, period):
+    """us per step of the scene in plain YADE with only the floor's read (_floor) every `period`
+    steps, finding the contacts left out."""
+    prepare(kind, n, "plain")
+    gc.collect()
+    return _floor(steps, period, finding=False)
 
 
 def per_step(sizes, repeats):
     print(f"\n1. Cost per step, breakage out of reach (us per step, the median of {repeats} runs "
-          f"up to 1e4 bodies, the modes in turn; ratio to plain YADE)")
+          f"up to 1e4 bodies, the modes in turn; ratio to plain YADE). floor: plain YADE with "
+          f"the mill's floor read (part 4) at the default's mean read period in that round")
     attach_times = {}
     for kind in ("dense", "collisional"):
         for n in sizes:
             steps = steps_for(n)
-            runs = {mode: [] for mode in MODES}
+            runs = {mode: [] for mode in (*MODES, "floor")}
             for _ in range(repeats if n <= 10000 else 1):
                 for mode in MODES:
-                    us, contacts, _, attach_s = rate(kind, n, mode, steps)
+                    us, contacts, _, attach_s, reads = rate(kind, n, mode, steps)
                     runs[mode].append(us)
                     if mode == "default":
                         attach_times[n] = attach_s
+                        period = max(1, round(steps / max(reads, 1)))
+                runs["floor"].append(floor_rate(kind, n, steps, period))
             rates = {mode: float(np.median(v)) for mode, v in runs.items()}
             plain = rates["plain"]
             print(f"  {kind:11s} {n:7d} bodies, {contacts:6d} contacts, {steps} steps: plain "
                   f"{plain:9.1f}; " + "; ".join(f"{m} {rates[m]:9.1f} ({rates[m] / plain:.2f}x)"
-                                                for m in MODES if m != "plain"))
+                                                for m in rates if m != "plain")
+                  + f" (the default read every {period} steps)")
     return attach_times
 
 
@@ -161,7 +186,7 @@ def with_breakage(sizes):
         steps = steps_for(n)
         rates, broken = {}, {}
         for mode in MODES:
-            rates[mode], _, broken[mode], _ = rate("collisional", n, mode, steps, True, 25.0)
+            rates[mode], _, broken[mode], _, _ = rate("collisional", n, mode, steps, True, 25.0)
         plain = rates["plain"]
         print(f"  {n:7d} bodies, {steps} steps: plain {plain:9.1f}; " + "; ".join(
             f"{m} {rates[m]:9.1f} ({rates[m] / plain:.2f}x, {broken[m]} breakages)"
@@ -251,18 +276,24 @@ def _touch_ore_contacts():
         phys.normalForce.norm()
 
 
-def _floor(steps, period):
-    """us per step of the scene with only the floor's read every `period` steps."""
+def _floor(steps, period, finding=True):
+    """us per step of the scene with only the floor's read every `period` steps; `finding`: the
+    time of taking the contacts from YADE every 100 steps counted (the mill), else left out (a
+    bound below any reader, however it finds its contacts: part 1)."""
     ore = {b.id for b in O.bodies if b is not None and b.material.label == "ore"}
     O.engines = O.engines + [_w.PyRunner(iterPeriod=period, command="_touch_ore_contacts()")]
     sys.modules["__main__"]._touch_ore_contacts = _touch_ore_contacts
+    left_out = 0.0
     t0 = time.perf_counter()
     for done in range(0, steps, 100):
+        found = time.perf_counter()
         # YADE's objects kept, as the engine's reader keeps them (an erased contact's are dropped)
         _ORE_CONTACTS[:] = [(i.geom, i.phys) for i in O.interactions.all(True)
                             if i.id1 in ore or i.id2 in ore]
+        if not finding:
+            left_out += time.perf_counter() - found
         engine.run_steps(min(100, steps - done))
-    return 1e6 * (time.perf_counter() - t0) / steps
+    return 1e6 * (time.perf_counter() - t0 - left_out) / steps
 
 
 def _rss():
@@ -292,12 +323,16 @@ def main():
     parser.add_argument("--repeats", type=int, default=3,
                         help="runs of each mode up to 1e4 bodies and on the mill (median)")
     parser.add_argument("--mill-only", action="store_true", help="only the ball mill (part 4)")
+    parser.add_argument("--per-step-only", action="store_true",
+                        help="only the cost per step with breakage out of reach (part 1)")
     args = parser.parse_args(sys.argv[1:])
     if args.mill_only:
         return mill(repeats=args.repeats)
     sizes = ([int(float(s)) for s in args.sizes.split(",")] if args.sizes
              else [1000, 10000] if args.quick else [1000, 10000, 100000])
     attach_times = per_step(sizes, args.repeats)
+    if args.per_step_only:
+        return None
     with_breakage(sizes)
     event_cost(sizes)
     mill(repeats=args.repeats)
