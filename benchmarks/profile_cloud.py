@@ -109,9 +109,9 @@ class Floor:
     check of the run), a visit of each zeroed pair awake (its two positions, their distance, its
     two stiffnesses written) and a read of each contact row awake (its overlap and normal
     force), these two at their unit costs timed at the end of the run; the counts of pairs and
-    rows awake sampled at each check (every 50 steps); and the two PyRunner calls a step makes
-    (YADE compiles a runner's command at every call), timed at the end of the run on a runner
-    whose command has the shape of yadebreak's and does nothing."""
+    rows awake sampled at each check (every 50 steps); and the two PyRunner calls a step makes,
+    at what YADE's least call costs (a runner whose command is `pass`), timed at the end of the
+    run (_runner_costs)."""
 
     def __init__(self, brk):
         self.brk = brk
@@ -127,12 +127,13 @@ class Floor:
     def report(self, yade_ms):
         s = np.array(self.samples)
         pair, row = self._unit_costs()
-        runner = self._runner_cost()
+        runner, shaped = self._runner_costs()
         counts, pairs, rows = s.mean(axis=0)
         per_step = 1e3 * (counts + pairs * pair + rows * row + 2 * runner)
         print(f"  floor, per step (means of {len(s)} checks): counts {1e3 * counts:.3f} ms; "
               f"{pairs:.0f} pairs awake x {1e6 * pair:.2f} us; {rows:.0f} rows awake x "
-              f"{1e6 * row:.2f} us; 2 runner calls x {1e6 * runner:.1f} us")
+              f"{1e6 * row:.2f} us; 2 runner calls x {1e6 * runner:.1f} us (of yadebreak's "
+              f"shape: {1e6 * shaped:.1f} us)")
         print(f"  floor                     {per_step:8.3f} ms = {per_step / yade_ms:.2f} x YADE "
               f"alone: whole step at best {1.0 + per_step / yade_ms:.2f} x")
 
@@ -166,18 +167,25 @@ class Floor:
 
 
     @staticmethod
-    def _runner_cost(steps=2000):
-        """Seconds a PyRunner call costs YADE here, with nothing done in it: a runner whose
-        command has the shape of yadebreak's hooks' runs `steps` more steps beside them."""
+    def _runner_costs(steps=300, rounds=4):
+        """Seconds a PyRunner call costs YADE here with nothing done in it (medians of `rounds`
+        runs of `steps` more steps each, beside yadebreak's runners): (the least, a command
+        `pass`; a command of the shape of yadebreak's hooks, which import yadebreak by name so
+        that a saved scene runs in a fresh process). YADE compiles a runner's command at every
+        call, so the shape costs more than `pass`."""
         from yadebreak.adapter.yade_api import wrapper
-        idle = wrapper.PyRunner(
-            command="__import__('yadebreak.engine.parts.protocol').engine.parts.protocol."
-                    "HOOKS.index('after_interactions')",
-            iterPeriod=1, updateGlobals=False, label="floor_idle")
-        O.engines = O.engines + [idle]
-        engine.run_steps(steps)
-        O.engines = [e for e in O.engines if e is not idle]
-        return idle.execTime * 1e-9 / steps
+        shaped = ("__import__('yadebreak.engine.parts.protocol').engine.parts.protocol."
+                  "HOOKS.index('after_interactions')")
+        costs = {"pass": [], shaped: []}
+        for _ in range(rounds):
+            for command, out in costs.items():
+                idle = wrapper.PyRunner(command=command, iterPeriod=1, updateGlobals=False,
+                                        label="floor_idle")
+                O.engines = O.engines + [idle]
+                engine.run_steps(steps)
+                O.engines = [e for e in O.engines if e is not idle]
+                out.append(idle.execTime * 1e-9 / steps)
+        return float(np.median(costs["pass"])), float(np.median(costs[shaped]))
 
 
 def _timed(call, repeats):
