@@ -14,23 +14,15 @@ import numpy as np
 
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
-from yadebreak.model import equations, families  # noqa: E402
+from yadebreak.model import families  # noqa: E402
 from yadebreak.model.materials import load_material  # noqa: E402
 
 
 def rebuilt_t10(fset, beta_params, fines):
     """Probability-weighted t10 (%) of the families of `fset` with their dummies spread by
     `fines` ("gaudin_schuhmann" or "eq10"); sizes relative to the parent's."""
-    total = 0.0
-    sizes, volumes = families.RELATIVE_SIZES[:families.DUMMY], families.CLASS_VOLUMES
-    for counts, p in zip(fset.counts, fset.probabilities):
-        resolved = (np.repeat(sizes, counts[:families.DUMMY]),
-                    np.repeat(volumes[:families.DUMMY], counts[:families.DUMMY]))
-        dummies = ([counts[families.DUMMY] * volumes[families.DUMMY]], [1.0], [fset.t10])
-        sd = equations.size_distribution(np.array([0.1]), resolved=resolved, dummies=dummies,
-                                         beta_params=beta_params, fines=fines)
-        total += p * 100.0 * sd.passing_mass[0] / sd.total_mass
-    return total
+    return sum(p * families.family_passing(counts, fset.t10, beta_params, [0.1], fines)[0]
+               for counts, p in zip(fset.counts, fset.probabilities))
 
 
 parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])

@@ -36,17 +36,21 @@ def test_small_bed_writes_every_output_and_conserves_mass(scene, tmp_path):
     assert len(lines) == len(brk.events)
 
 
-def test_higher_energy_breaks_more_mass(scene, tmp_path):
+def test_higher_energy_breaks_more_mass_and_sinks_the_ball_deeper(scene, tmp_path):
+    """Three times the energy: more broken mass, and the ball sinks deeper into the one-layer bed
+    (its penetration positive and less than the particles' size: it never reaches the anvil)."""
     from yadebreak.jobs import bed
     from yadebreak import engine
     from yade import O
-    masses = []
+    masses, depths = [], []
     for energy in (0.3, 0.9):
         engine.forget()
         O.reset()
         _, summary = bed.run(_args(tmp_path / f"e{energy}", energy, seed=5), quiet=True)
         masses.append(summary["broken_mass"])
+        depths.append(summary["penetration"])
     assert masses[1] > masses[0]
+    assert 0.0 < depths[0] < depths[1] < 5.5e-3
 
 
 def test_bed_script_runs_headless(tmp_path):

@@ -122,7 +122,9 @@ def test_the_mills_dmin_is_its_declared_third_of_the_feed():
 def test_a_hand_made_namespace_takes_the_declared_defaults():
     options = job_options.attach_options("bed_impact", argparse.Namespace(dmin=0.0))
     assert options["dmin"] is None and options["dummies"] == "ledger"
-    assert options["read_period"] == "fast" and options["break_at"] == "threshold"
+    assert options["read_period"] == "fast" and options["outcome"] == "paper"
+    assert options["break_at"] is None                     # the outcome's: 'threshold'
+    assert Config.from_options(**options).criteria.break_at == "threshold"
 
 
 @pytest.mark.parametrize("saved, today", [
@@ -132,5 +134,16 @@ def test_a_hand_made_namespace_takes_the_declared_defaults():
      {"global_damping": 0.0, "global_damping_time": "forever"}),
 ])
 def test_an_old_checkpoints_arguments_read_as_todays(saved, today):
-    now = {"global_damping": "x", "global_damping_time": "y", "break_at": "threshold"}
-    assert job_options.arguments_of_today(saved, now) == {**today, "break_at": "threshold"}
+    now = {"global_damping": "x", "global_damping_time": "y", "break_at": "outcome",
+           "outcome": "paper"}
+    assert job_options.arguments_of_today(saved, now) == {**today, "break_at": "outcome",
+                                                          "outcome": "paper"}
+
+
+def test_a_checkpoint_from_before_the_outcome_option_reads_its_break_at_as_todays():
+    """Before `outcome`, --break-at threshold was the default; today it is --break-at outcome
+    with --outcome paper (the same run), so such a checkpoint resumes; a peak stays a peak."""
+    now = {"break_at": "outcome", "outcome": "paper"}
+    assert job_options.arguments_of_today({"break_at": "threshold"}, now) == now
+    assert job_options.arguments_of_today({"break_at": "peak"}, now) == {**now,
+                                                                         "break_at": "peak"}

@@ -9,7 +9,7 @@ from yadebreak.studies.verify import readings
 
 
 def _run(seed, broken, t10, se, passing, model=(0.5, 5.0, 50.0), t10_model=4.0):
-    return {"seed": seed, "particles": 8, "broken_fraction": broken / 8, "t10_simulated": t10,
+    return {"seeds": [seed], "particles": 8, "broken_fraction": broken / 8, "t10_simulated": t10,
             "t10_standard_error": se, "t10_model": t10_model, "breakage_events_all_generations": 3,
             "relative_sizes": [0.01, 0.1, 0.5], "progeny_passing_simulated": list(passing),
             "progeny_passing_model": list(model)}

@@ -122,11 +122,11 @@ def test_runs_queued_together_in_a_pool_give_what_they_give_one_by_one(scene):
     the other in this process, to the last digit (but the time taken); each set ran once, and
     the pool is gone after close()."""
     from yadebreak.studies.verify.settings import Run, Runner, paper_options
-    runs = [Run("copper_ore", 5.5e-3, [700.0, 1500.0], 3, 4,
+    runs = [Run("copper_ore", 5.5e-3, [700.0, 1500.0], 3, (4, 5),
                 paper_options(0.05, read_period="fast")),
-            Run("copper_ore", 5.5e-3, [400.0], 6, 4, paper_options(0.05, replace=False),
+            Run("copper_ore", 5.5e-3, [400.0], 6, (4,), paper_options(0.05, replace=False),
                 per_scene=3),
-            Run("copper_ore", 5.5e-3, [1500.0], 2, 4, paper_options(0.05, read_period="fast"),
+            Run("copper_ore", 5.5e-3, [1500.0], 2, (4,), paper_options(0.05, read_period="fast"),
                 test="drop_weight")]
     results = []
     for jobs in (1, 2):
@@ -160,7 +160,7 @@ def test_the_plan_holds_every_figure_s_first_runs_and_leaves_no_plot_open(tmp_pa
     add_params(parser, verify.PARAMS)
     args = read_params(parser.parse_args(["--quick", "1", "--out", str(tmp_path)]), verify.PARAMS)
     args.material_list, args.energy_list = ["copper_ore"], [1000.0]
-    args.damping_list = [0.0, 0.1, 0.3]
+    args.damping_list, args.seeds, args.seed = [0.0, 0.1, 0.3], (3,), 3
     planned = plan(list(verify.FIGURES[name] for name in verify.DEFAULT_FIGURES), args, tmp_path)
     tasks = [t for t in planned if isinstance(t, Task)]
     runs = [r for r in planned if not isinstance(r, Task)]

@@ -10,14 +10,14 @@ import numpy as np
 from yadebreak import model
 
 
-def product_size_distribution(table, ledger, materials, sizes, fines=True,
-                              fines_model="gaudin_schuhmann"):
+def product_size_distribution(table, ledger, materials, sizes, fines, fines_model):
     """The product size distribution (model.SizeDistribution, docs/model.md Section 7) of the
     bodies of a body table (coupling.state.BodyTable) and a fines ledger.
 
     fines=True spreads dummy and unbreakable masses (Eqs. 11-13); fines=False counts every sphere
-    at its own size, as in the paper's Fig. 13. fines_model: "gaudin_schuhmann" (the paper's
-    Eqs. 11-12) or "eq10" (see model.dummy_fines_passing). materials: label -> Material.
+    at its own size, as in the paper's Fig. 13. fines_model: how the dummies' fines are spread,
+    "gaudin_schuhmann" (the paper's Eqs. 11-12) or "eq10" (model.dummy_fines_passing; the
+    option `outcome` chooses). materials: label -> Material.
     """
     resolved_d, resolved_m = [], []
     groups = {}
@@ -87,6 +87,8 @@ class ImpactTally:
     spheres in the scene as they are (no fines: the paper's Fig. 13); masses (kg) of the scenes at
     their start and end; scene_t10: [broken mass, mass passing size / 10] (kg) of each scene that
     broke (scenes are independently seeded: their scatter is t10's standard error);
+    scene_passing: each such scene's progeny mass passing size x RELATIVE_SIEVES (kg), for the
+    passing's standard errors;
     scene_wall_s: the wall time (s) of the scenes added up, wherever each ran; yade_engines_s: of
     it, the time YADE's own engines took (timed by YADE; the rest is yadebreak's runners and the
     scenes' building and checks)."""
@@ -104,6 +106,7 @@ class ImpactTally:
     steps: int = 0
     scenes_at_step_limit: int = 0
     scene_t10: list = field(default_factory=list)
+    scene_passing: list = field(default_factory=list)
     scene_wall_s: float = 0.0
     yade_engines_s: float = 0.0
 
@@ -124,7 +127,9 @@ class ImpactTally:
         self.e_cum_intact += [brk.bodies[i].e_cum for i in ids
                               if i not in broken and i in brk.bodies]
         if broken:
-            self.progeny_mass += brk.size_distribution(self.size * RELATIVE_SIEVES).passing_mass
+            passing = brk.size_distribution(self.size * RELATIVE_SIEVES).passing_mass
+            self.progeny_mass += passing
+            self.scene_passing.append(passing.tolist())
             markers = brk.size_distribution(self.size / np.array(MARKERS)).passing_mass
             self.marker_mass += markers
             self.scene_t10.append([sum(first[i]["mass"] for i in broken),
@@ -144,6 +149,7 @@ class ImpactTally:
         self.first += other.first
         self.e_cum_intact += other.e_cum_intact
         self.scene_t10 += other.scene_t10
+        self.scene_passing += other.scene_passing
         self.progeny_mass = self.progeny_mass + other.progeny_mass
         self.marker_mass = self.marker_mass + other.marker_mass
         self.resolved_mass = self.resolved_mass + other.resolved_mass
@@ -179,14 +185,31 @@ class ImpactTally:
     @property
     def t10_standard_error(self):
         """Standard error (%) of t10 (the ratio of the scenes' passing at size / 10 to their broken
-        mass) from the scatter between scenes: sqrt(n / (n - 1) sum (p_i - t m_i)^2) / sum m_i;
-        None with fewer than two scenes that broke."""
-        n = len(self.scene_t10)
-        if n < 2:
+        mass) from the scatter between scenes (ratio_standard_error); None with fewer than two
+        scenes that broke."""
+        if len(self.scene_t10) < 2:
             return None
         m, p = np.array(self.scene_t10, dtype=float).T
-        t = p.sum() / m.sum()
-        return float(100.0 * np.sqrt(n / (n - 1) * np.sum((p - t * m) ** 2)) / m.sum())
+        return float(ratio_standard_error(m, p[:, None])[0])
+
+    @property
+    def passing_standard_error(self):
+        """Standard errors (%) of the progeny's passing at size x RELATIVE_SIEVES, as t10's; None
+        with fewer than two scenes that broke (or scenes tallied before they were kept)."""
+        if len(self.scene_passing) < 2 or len(self.scene_passing) != len(self.scene_t10):
+            return None
+        m = np.array(self.scene_t10, dtype=float)[:, 0]
+        return ratio_standard_error(m, np.array(self.scene_passing, dtype=float)).tolist()
+
+
+def ratio_standard_error(masses, passing):
+    """Standard error (%) of the ratio sum p_i / sum m_i of independent scenes i (masses (n,),
+    passing (n, k): k ratios at once): 100 sqrt(n / (n - 1) sum (p_i - t m_i)^2) / sum m_i, t the
+    ratio (the delta method for a ratio estimator)."""
+    n, total = len(masses), masses.sum()
+    t = passing.sum(axis=0) / total
+    return 100.0 * np.sqrt(n / (n - 1) * np.sum((passing - t * masses[:, None]) ** 2,
+                                                axis=0)) / total
 
 
 def breakage_result(brk, ids, material, size, specific_energy, partner):
@@ -223,6 +246,7 @@ def breakage_result_of(tally, material, specific_energy, partner):
     result.update({
         "t10_simulated": float(markers[MARKERS.index(10.0)]),
         "t10_standard_error": tally.t10_standard_error,
+        "progeny_passing_standard_error": tally.passing_standard_error,
         "t10_primary_events": float(np.mean([e["t10"] for e in broken])),
         "breakage_events_all_generations": tally.breakage_events,
         "progeny_markers": {f"t{n:g}": {"simulated": float(sim), "model": _t_n(material, t10_model, n)}

@@ -58,9 +58,10 @@ class Criterion:
     def parse_more(breakage, values, problems):
         """The keys more_keys of [breakage] into `values` (SI): none here."""
 
-    def with_settings(self, kappa_successive=None, t10_energy="particle"):
-        """This criterion with Eq. 8's kappa of fragments and the energy of a breakage's t10'
-        (attach()'s kappa_successive, t10_energy) set; criteria without Eq. 8: itself."""
+    def with_settings(self, kappa_successive=None, t10_energy="particle", batch_kappa=False):
+        """This criterion with Eq. 8's kappa of fragments, the energy of a breakage's t10' and
+        the batch kappa (attach()'s kappa_successive, t10_energy, kappa='batch') set; criteria
+        without Eq. 8: itself."""
         return self
 
     # -- the fracture-energy distribution ---------------------------------------------------

@@ -104,14 +104,15 @@ class Recording(Criterion):
         return self.inner.force(table, i, ratio)
 
 
-def criterion_for(material, breakage=True, kappa_successive=None, t10_energy="particle"):
+def criterion_for(material, breakage=True, kappa_successive=None, t10_energy="particle",
+                  batch_kappa=False):
     """The criterion of a breakable Material for the engine: material.criterion itself (the
     object the model side uses), with Eq. 8's kappa of fragments when kappa_successive is given
-    (Tavares; None: the material's) and the energy of a breakage's t10' (t10_energy), wrapped
-    in Recording when breakage=False."""
+    (Tavares; None: the material's), the energy of a breakage's t10' (t10_energy) and
+    batch_kappa (attach's kappa='batch'), wrapped in Recording when breakage=False."""
     criterion = material.criterion
-    if kappa_successive is not None or t10_energy != "particle":
-        criterion = criterion.with_settings(kappa_successive, t10_energy)
+    if kappa_successive is not None or t10_energy != "particle" or batch_kappa:
+        criterion = criterion.with_settings(kappa_successive, t10_energy, batch_kappa)
     if breakage:
         return criterion
     return Recording(criterion)

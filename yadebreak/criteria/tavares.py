@@ -44,10 +44,12 @@ class Tavares(Criterion):
     #: read plus 0.2 us per body
     judged_one_by_one = 24
 
-    def __init__(self, material, kappa_successive=None, t10_energy="particle"):
+    def __init__(self, material, kappa_successive=None, t10_energy="particle",
+                 batch_kappa=False):
         super().__init__(material)
         self.kappa_successive = kappa_successive
         self.t10_energy = t10_energy
+        self.batch_kappa = batch_kappa
 
     @staticmethod
     def parse_more(breakage, values, problems):
@@ -57,8 +59,8 @@ class Tavares(Criterion):
                           default=model.DEVICE_STIFFNESS_STEEL / 1e9)
         values["device_stiffness"] = None if dev is None else dev * 1e9
 
-    def with_settings(self, kappa_successive=None, t10_energy="particle"):
-        return Tavares(self.material, kappa_successive, t10_energy)
+    def with_settings(self, kappa_successive=None, t10_energy="particle", batch_kappa=False):
+        return Tavares(self.material, kappa_successive, t10_energy, batch_kappa)
 
     # -- model side -----------------------------------------------------------------------------
     def median_fracture_energy(self, size):
@@ -101,9 +103,18 @@ class Tavares(Criterion):
 
     @property
     def t10_min(self):
-        """Eq. 9 (%)."""
+        """Eq. 9 (%); with batch_kappa at kappa = exp(sigma^2 / 2), the paper's largest (the
+        family table's floor)."""
         m = self.material
-        return float(model.t10_primary(m.A, m.b_prime, m.kappa))
+        kappa = math.exp(m.sigma ** 2 / 2.0) if self.batch_kappa else m.kappa
+        return float(model.t10_primary(m.A, m.b_prime, kappa))
+
+    def kappa_of_batch(self, absorbed, size):
+        """The kappa at which Eq. 8's mean over the particles of size `size` (m) that break at
+        `absorbed` (J/kg) is Eq. 7 (model.kappa_of_batch)."""
+        m = self.material
+        return model.kappa_of_batch(absorbed, float(self.median_fracture_energy(size)), m.sigma,
+                                    m.emax_ratio, m.A, m.b_prime)
 
     @property
     def t10_ceiling(self):
@@ -165,6 +176,9 @@ class Tavares(Criterion):
             return ratio, float(self.t10_once(ek / mass, 2.0 * float(c["radius"][i]))), {}
         kappa = (None if self.kappa_successive is None or c["generation"][i] == 0
                  else self.kappa_successive)
+        if kappa is None and self.batch_kappa:
+            kappa = self.kappa_of_batch(ek / mass, 2.0 * float(c["radius"][i]))
+            return ratio, float(self.t10(ratio, kappa)), {"kappa": kappa}
         return ratio, float(self.t10(ratio, kappa)), {}
 
     def t10_at_threshold(self, table, i, threshold):

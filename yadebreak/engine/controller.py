@@ -66,7 +66,8 @@ class Controller:
         self.label_by_id = scene_materials.label_by_id
         self.criteria = {lab: criterion_for(mat, config.criteria.breakage,
                                             config.criteria.kappa_successive,
-                                            config.criteria.t10_energy)
+                                            config.criteria.t10_energy,
+                                            config.criteria.kappa == "batch")
                          for lab, mat in self.material.items()}
         labels = list(self.material)
         self.state = state or EngineState(labels, config.seed, config.output.event_log)
@@ -109,7 +110,9 @@ class Controller:
         dummies = (scene_materials.dummy_by_label
                    if config.replacement.dummy_stiffness != 1.0 else {})
         return {lab: Recipe(self.criteria[lab],
-                            families.table_for(mat, config.replacement.family_seed),
+                            families.family_table(mat.beta_params, self.criteria[lab].t10_min,
+                                                  self.criteria[lab].t10_ceiling,
+                                                  config.replacement.family_seed),
                             self.pause_steps[lab], (lab in damped) if damped else None,
                             dummies.get(lab))
                 for lab, mat in self.material.items()}
@@ -173,10 +176,13 @@ class Controller:
         """Mass (kg) of every body yadebreak knows, fragments and ledger fines included."""
         return self.state.total_mass()
 
-    def size_distribution(self, sizes, fines=True, fines_model="gaudin_schuhmann"):
-        """The product size distribution, fines included (reports.product_size_distribution)."""
+    def size_distribution(self, sizes, fines=True, fines_model=None):
+        """The product size distribution, fines included (reports.product_size_distribution);
+        fines_model None: the attached outcome's ("gaudin_schuhmann" for 'paper', "eq10" for
+        'model')."""
         return reports.product_size_distribution(self.state.table, self.state.ledger,
-                                                 self.material, sizes, fines, fines_model)
+                                                 self.material, sizes, fines,
+                                                 fines_model or self.config.fines)
 
     # -- set-up --------------------------------------------------------------------------------
     def register(self, spheres):

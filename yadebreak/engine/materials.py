@@ -197,7 +197,9 @@ _VOLUMETRIC = (("young", Interval(0.0, math.inf, lo_open=True, hi_open=True), "N
 def resolve(materials, kappa=None, emax_ratio=None, law="hertz_mindlin"):
     """Map the checked {label: Material} (check_mapping) onto the scene's labelled YADE
     materials, with the options that override the files (Tavares materials only). `law`: the
-    contact law the engine reads (scene.contact_law)."""
+    contact law the engine reads (scene.contact_law). A `kappa` that is a word ('batch') is
+    the criterion's to apply (recording.criterion_for), not a number to write into the file."""
+    kappa = None if isinstance(kappa, str) else kappa
     by_label = {lab: criterion_for(mat).overridden(kappa=kappa, emax_ratio=emax_ratio)
                 for lab, mat in materials.items()}
     stiffness, label_by_id = {}, {}

@@ -129,6 +129,7 @@ class BedImpact(skeleton.Job):
             #                                                   goes on as this one, bit for bit
         self.frames()                             # a frame if one is due (before the checkpoint)
         vz = view.velocity(self.info["ball"])[2]
+        self._follow_the_ball()
         if loop["touched"] is not None and loop["turned"] is None and vz >= 0.0:
             loop["turned"] = view.now()            # deepest penetration: loading is over
         # breakage happens while loading: after the turn, a short unloading, then open events
@@ -139,6 +140,16 @@ class BedImpact(skeleton.Job):
             self.say(f"stopped at max_time = {self.args.max_time} s of simulated time")
             return "time_limit"
         return None
+
+    def _follow_the_ball(self):
+        """The ball's height at the first chunk's end that finds it in contact, and its lowest
+        at a chunk's end since (the penetration's two ends, within one chunk's travel)."""
+        loop, z = self.loop, view.position(self.info["ball"])[2]
+        if loop.get("first_contact_z") is None:
+            if view.in_contact(self.info["ball"]):
+                loop["first_contact_z"] = loop["lowest_z"] = z
+        else:
+            loop["lowest_z"] = min(loop["lowest_z"], z)
 
     def at_safe_point(self):
         """Every SAFE_EVERY chunks (engine.reload costs 20 to 30 ms, 400 steps 80 to 220 ms)."""
@@ -220,6 +231,8 @@ def _report(brk, info, loop, args, out, energy, runtime, end_reason, end_message
         "mass_relative_error": abs(brk.total_mass() - initial_mass) / initial_mass,
         "broken_mass": broken_mass, "broken_mass_fraction": broken_mass / initial_mass,
         "capture_radius": capture_radius(brk, info),
+        "penetration": (None if loop.get("first_contact_z") is None
+                        else loop["first_contact_z"] - loop["lowest_z"]),
         "breakage_events": len(brk.breakage_events),
         "damage_events": sum(1 for e in brk.events if e["kind"] == "damage"),
         "particles_broken": fates.count("broken"), "particles_damaged": fates.count("damaged"),

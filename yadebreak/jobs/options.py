@@ -60,7 +60,7 @@ def laboratory_test(size, middle, out, resume_help, what, engine=(), overrides=N
     (energies or impacts)."""
     return JobOptions(
         own=lambda: [material_option(), size_option(size), *middle],
-        engine=(*engine, "time_step_fraction", "read_period"),
+        engine=(*engine, "time_step_fraction", "read_period", "outcome", "kappa"),
         overrides={**EXACT_READS, **(overrides or {})},
         run=lambda: [
             out_option(out),
@@ -118,7 +118,7 @@ LEDGER = Override("ledger", "the fines as a mass ledger: the broken mass within 
 BED_IMPACT = JobOptions(
     own=_bed_own,
     engine=("time_step_fraction", "dmin", "global_damping", "global_damping_time", "dummies",
-            "dummy_stiffness", "read_period", "break_at"),
+            "dummy_stiffness", "read_period", "outcome", "break_at"),
     overrides={"dummies": LEDGER},
     run=lambda: checkpointed_run_options(1e-4, "out/bed_impact"),
     check=lambda args: _check_bed_impact(args))
@@ -203,7 +203,7 @@ def _ball_mill_own():
 
 BALL_MILL = JobOptions(
     own=_ball_mill_own,
-    engine=("time_step_fraction", "dmin", "read_period", "break_at", "breakage"),
+    engine=("time_step_fraction", "dmin", "read_period", "outcome", "break_at", "breakage"),
     overrides={
         "dummies": Override("ledger", "thousands of breakages: dummy spheres would multiply the "
                                       "bodies and shrink the time step"),
@@ -336,8 +336,8 @@ def attach_options(job, args, **more):
 
 #: script options added since a checkpoint could have been written, at the value that gives the
 #: behaviour of the scripts before them: a checkpoint without them resumes at that value
-ADDED_OPTIONS = {"break_at": "threshold", "dummy_stiffness": 1.0, "shape": "sphere",
-                 "vtk_interval": 0.0}
+ADDED_OPTIONS = {"break_at": "outcome", "outcome": "paper", "dummy_stiffness": 1.0,
+                 "shape": "sphere", "vtk_interval": 0.0}
 
 
 def arguments_of_today(saved, now):
@@ -345,7 +345,10 @@ def arguments_of_today(saved, now):
     arguments `now` (an option added since, at the value that was the behaviour then, is no
     difference). Before --global-damping-time, the bed's --global-damping 0 meant the material
     file's damping and a value g > 0 meant g for 5e-4 s: they are --global-damping material
-    (forever) and g with --global-damping-time 5e-4."""
+    (forever) and g with --global-damping-time 5e-4. Before --outcome, --break-at threshold was
+    what --break-at outcome is now."""
+    if "outcome" not in saved and saved.get("break_at") == "threshold":
+        saved = {**saved, "break_at": "outcome"}      # the paper's outcome's, as written now
     saved = {**{k: v for k, v in ADDED_OPTIONS.items() if k in now}, **saved}
     if "global_damping" in saved and "global_damping_time" in set(now) - set(saved):
         damping = saved["global_damping"]

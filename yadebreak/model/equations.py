@@ -21,7 +21,8 @@ __all__ = ['N_VALUES', 'TABLE1_BETA_PARAMS', 'DEVICE_STIFFNESS_STEEL', 'X_MIN', 
            'energy_partition', 'median_fracture_energy', 'fracture_energy_cdf',
            'fracture_energy_logpdf', 'fracture_energy_ppf', 'sample_fracture_energy',
            'breakage_probability', 'damage', 'weakened_fracture_energy', 'parabolic_peak', 't10',
-           'median_fracture_energy_broken', 't10_batch', 't10_primary', 't_n', 't_markers',
+           'median_fracture_energy_broken', 't10_batch', 't10_mean_broken', 'kappa_of_batch',
+           't10_primary', 't_n', 't_markers',
            'fines_exponent', 'fines_passing', 'progeny_passing', 'SizeDistribution',
            'dummy_fines_passing', 'size_distribution', 'repeated_impact_broken_fraction',
            'ab_t10_min_energy', 'ab_t10_update', 'ab_t10_probability', 'ab_t10_threshold',
@@ -303,6 +304,48 @@ def t10_batch(specific_energy, e50b, A, b_prime):
     broken ones have the median fracture energy e50b (J/kg, median_fracture_energy_broken):
     t10 = A [1 - exp(-b' (Ek/mp) / E50b)]. Both energies on the same footing (here: absorbed)."""
     return t10(np.asarray(specific_energy, dtype=float) / e50b, A, b_prime)
+
+
+def t10_mean_broken(specific_energy, e50, sigma, emax_ratio, A, b_prime, kappa=1.0, nodes=64):
+    """Eq. 8 (%) averaged over the particles that break when each absorbs `specific_energy`
+    (J/kg, a scalar): their fracture energies are Eqs. 1-2 below it, so the mean is over the
+    probability u in (0, P) of E(u) = fracture_energy_ppf(u) (Gauss-Legendre, `nodes` points).
+    At kappa = 1 it exceeds Eq. 7 (t10_batch over E50b) by up to exp(sigma^2 / 2) where t10 is
+    small (the mean of 1/E over a lognormal): the gap that the paper's kappa closes. NaN where
+    nothing breaks."""
+    energy, weight = _broken_quadrature(specific_energy, e50, sigma, emax_ratio, nodes)
+    if energy is None:
+        return math.nan
+    return float(weight @ t10(specific_energy / energy, A, b_prime, kappa))
+
+
+def _broken_quadrature(specific_energy, e50, sigma, emax_ratio, nodes):
+    """Gauss-Legendre nodes (fracture energies, J/kg) and weights (sum 1) over the particles
+    that break at `specific_energy`; (None, None) where none does."""
+    p = float(fracture_energy_cdf(specific_energy, e50, sigma, emax_ratio))
+    if not p > 0.0:
+        return None, None
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    return fracture_energy_ppf(0.5 * p * (x + 1.0), e50, sigma, emax_ratio), 0.5 * w
+
+
+def kappa_of_batch(specific_energy, e50, sigma, emax_ratio, A, b_prime, nodes=64):
+    """The kappa of Eq. 8 at which its mean over the particles that break at `specific_energy`
+    (J/kg, absorbed; t10_mean_broken) is Eq. 7 at that energy: the paper's definition of kappa
+    ("Values of kappa were found to vary from about 0.95 to exp(sigma^2/2)", Section 2.2),
+    computed from Eqs. 1-2 and 7-8 instead of the empirical expressions it cites. NaN where
+    nothing breaks."""
+    from scipy.optimize import brentq
+    target = float(t10_batch(specific_energy, median_fracture_energy_broken(
+        specific_energy, e50, sigma, emax_ratio), A, b_prime))
+    energy, weight = _broken_quadrature(specific_energy, e50, sigma, emax_ratio, nodes)
+    if energy is None or not np.isfinite(target):
+        return math.nan
+    scaled = b_prime * specific_energy / energy
+
+    def gap(log_kappa):          # Eq. 8's mean less Eq. 7, falling as kappa grows
+        return A * float(weight @ -np.expm1(-scaled * math.exp(-log_kappa))) - target
+    return math.exp(brentq(gap, math.log(0.05), math.log(20.0), xtol=1e-12))
 
 
 def t10_primary(A, b_prime, kappa=1.0):

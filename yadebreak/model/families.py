@@ -343,6 +343,20 @@ def _table_cached(beta_key, t10_min, t10_max, seed):
     return table
 
 
+def family_passing(counts, t10, beta_params, sieves, fines):
+    """Passing (%) of one family (its class counts, of a set made for `t10`') at `sieves`
+    (relative to the parent's size): its resolved spheres at their class sizes, its dummies'
+    mass spread by `fines` (model.dummy_fines_passing: "gaudin_schuhmann", the paper's Eqs.
+    11-12, or "eq10")."""
+    counts = np.asarray(counts)
+    resolved = (np.repeat(RELATIVE_SIZES[:DUMMY], counts[:DUMMY]),
+                np.repeat(CLASS_VOLUMES[:DUMMY], counts[:DUMMY]))
+    dummies = ([counts[DUMMY] * CLASS_VOLUMES[DUMMY]], [1.0], [t10])
+    sd = model.size_distribution(np.asarray(sieves, dtype=float), resolved=resolved,
+                                 dummies=dummies, beta_params=beta_params, fines=fines)
+    return sd.passing_percent
+
+
 def family_table(beta_params, t10_min, t10_max, seed=0):
     """The FamilyTable for a material, built once per process and cached on disk
     (<cache>/families: yadebreak.model.cache)."""

@@ -61,12 +61,12 @@ def engine_flag(name, overrides=None, where=""):
     lo, hi = o.interval.lo, o.interval.hi
     lo_open = o.interval.lo_open and token != lo          # a token 0 closes "> 0" to ">= 0"
     if o.kind == "number":
-        words = (token,) if isinstance(token, str) and token else ()
+        words = o.words + ((token,) if isinstance(token, str) and token else ())
         param = number(name, default, o.unit, helps, lo, hi, lo_open, o.interval.hi_open, words)
     elif o.kind in ("count", "read_period"):
         param = integer(name, default, helps, lo=lo, hi=hi, words=o.words, unit=o.unit)
     elif o.kind == "choice":
-        param = choice(name, default, o.words, helps)
+        param = choice(name, default, o.words + ((token,) if token else ()), helps)
     elif o.kind == "boolean":
         param = flag(name, default, helps)
     else:

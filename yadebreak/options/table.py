@@ -69,8 +69,8 @@ class Option:
         if v is None:
             return bool(self.none)
         if self.kind == "number":
-            return _number(self.interval.lo, self.interval.hi, self.interval.lo_open,
-                           self.interval.hi_open)(v)
+            return v in self.words or _number(self.interval.lo, self.interval.hi,
+                                              self.interval.lo_open, self.interval.hi_open)(v)
         if self.kind == "count":
             return _count(self.interval.lo)(v)
         if self.kind == "choice":
@@ -91,12 +91,28 @@ class Option:
         if self.kind == "read_period":
             first, *more, last = [repr(w) for w in self.words]
             text = ", ".join([first, *more, f"an integer {interval}"]) + f" or {last}"
+        elif self.kind == "number" and self.words:
+            text = " or ".join([text, *(repr(w) for w in self.words)])
         return text + (" or None" if self.none else "")
 
     @property
     def described(self):
         """The help with what None means (docs/options.md)."""
         return self.help + (f"; None: {self.none}" if self.none else "")
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a value of the `outcome` option fixes: when a body breaks (break_at) and how the
+    dummies' unresolved fines are spread (model.dummy_fines_passing's `fines`)."""
+
+    break_at: str
+    fines: str
+
+
+#: the values of `outcome`: the paper's reading, and the one whose product is the model's
+OUTCOMES = {"paper": Outcome(break_at="threshold", fines="gaudin_schuhmann"),
+            "model": Outcome(break_at="peak", fines="eq10")}
 
 
 def _row(name, group, default, kind, unit, help, lo=-math.inf, hi=math.inf, lo_open=False,
@@ -127,17 +143,31 @@ OPTIONS = (
          "fracture energy (a fresh contact's, at twice the top speed, included)", 0, 1,
          lo_open=True),
     # criteria: overrides of the material files and Rocky's safeguards
-    _row("kappa", "criteria", None, "number", "-", "overrides the material's kappa (Eq. 8)", 0,
-         lo_open=True, none="keeps the file's", token=0.0),
+    _row("kappa", "criteria", None, "number", "-",
+         "overrides the material's kappa (Eq. 8); 'batch': at each breakage the kappa at which "
+         "Eq. 8's mean over the particles of the body's size that break at its specific energy "
+         "is Eq. 7 (the paper's Section 2.2: 'Values of kappa were found to vary from about 0.95 "
+         "to exp(sigma^2/2)'; Tavares materials; docs/model.md)", 0, lo_open=True,
+         words=("batch",), none="keeps the file's", token=0.0),
     _row("kappa_successive", "criteria", None, "number", "-",
          "kappa of Eq. 8 for the breakage of fragments (generation >= 1; Tavares materials)", 0,
          lo_open=True, none="the same as the first breakage's (the paper's)", token=0.0),
-    _row("break_at", "criteria", "threshold", "choice", "-",
+    _row("outcome", "criteria", "paper", "choice", "-",
+         "what a breakage makes (docs/model.md, 'The outcome of a breakage'): 'paper', t10' of "
+         "Eq. 8 at the read where the energy first passes the fracture energy and the dummies' "
+         "fines spread by Eqs. 11-12 (the paper's Fig. 17 text and Section 2.4); 'model', t10' "
+         "of Eq. 8 at the whole stressing event's energy (break_at='peak') and the fines spread "
+         "by Eq. 10, so that one breakage's product is Eq. 10 at its t10' and single impacts "
+         "follow Eq. 7 (Eq. 8 with kappa 1 at each particle's whole share of the impact); "
+         "'model' refuses break_at='threshold' and t10_energy='e50b'",
+         words=tuple(OUTCOMES)),
+    _row("break_at", "criteria", None, "choice", "-",
          "when a body breaks and which energy gives its t10' (Eq. 8): 'threshold' at the read "
          "where its energy first passes its fracture energy (the paper); 'peak' once the "
          "stressing event stops rising, t10' from the event's largest energy (unbreakable "
          "fragments likewise record the t10' of the event's peak)",
-         words=("threshold", "peak")),
+         words=("threshold", "peak"), none="the outcome's ('threshold' for 'paper', 'peak' "
+         "for 'model')", token="outcome"),
     _row("t10_energy", "criteria", "particle", "choice", "-",
          "the fracture energy in a breakage's t10' (Rocky's 'Energy for t10 Calculation'; "
          "Tavares materials): 'particle', the body's own (Eq. 8; Rocky's default, 'Current "
@@ -228,6 +258,7 @@ class Reading:
 class Criteria:
     kappa: float | None
     kappa_successive: float | None
+    outcome: str
     break_at: str
     t10_energy: str
     emax_ratio: float | None
@@ -297,11 +328,19 @@ class Config:
         if values["dummies"] == "ledger" and values["dummy_stiffness"] != 1.0:
             problems.append(f"dummy_stiffness = {values['dummy_stiffness']!r}: needs "
                             "dummies='spheres' (a ledger keeps no dummy spheres)")
+        problems += _outcome_conflicts(values)
         if problems:
             raise AttachError("bad option(s): " + "; ".join(problems))
+        if values["break_at"] is None:
+            values["break_at"] = OUTCOMES[values["outcome"]].break_at
         groups = {g: kind(**{f.name: values[f.name] for f in fields(kind)})
                   for g, kind in _GROUPS.items()}
         return cls(seed=seed, **groups)
+
+    @property
+    def fines(self):
+        """How the dummies' unresolved fines are spread (model.dummy_fines_passing's `fines`)."""
+        return OUTCOMES[self.criteria.outcome].fines
 
     def as_options(self):
         """The flat {name: value} this config was made from (saved with the scene)."""
@@ -310,6 +349,20 @@ class Config:
             group = getattr(self, g)
             flat.update({f.name: getattr(group, f.name) for f in fields(group)})
         return flat
+
+
+def _outcome_conflicts(values):
+    """outcome='model' reads t10' of Eq. 8 at the event's whole energy: a threshold break or
+    Rocky's e50b energy would be another reading, so each is refused in one line."""
+    if values["outcome"] != "model":
+        return []
+    refused = {"break_at": ("threshold", "breaks at the stressing event's peak",
+                            "'peak' or None"),
+               "t10_energy": ("e50b", "takes the body's own fracture energy in Eq. 8",
+                              "'particle'")}
+    return [f"{name} = {value!r}: outcome='model' {why} (accepted with it: {accepted}); "
+            "outcome='paper' takes the other readings"
+            for name, (value, why, accepted) in refused.items() if values[name] == value]
 
 
 def options_markdown():

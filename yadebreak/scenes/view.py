@@ -48,6 +48,11 @@ def touching(i):
     return any(O.interactions.withBody(i))
 
 
+def in_contact(i):
+    """True if body i has a real interaction (its geometry overlaps another body's)."""
+    return any(j.isReal for j in O.interactions.withBody(i))
+
+
 def body_count():
     """Bodies in the scene (erased ones not counted)."""
     return sum(1 for b in O.bodies if b is not None)

@@ -2,7 +2,9 @@
 settings, as a Markdown report with one plot per figure (model lines and simulated points side by
 side, each figure's settings printed under it).
 
-The paper's settings (its Section 3; docs/verification.md): Emax/E50 = 4 in every
+The paper's settings (its Section 3; docs/verification.md), but for the outcome of a breakage
+(Figs. 13-19 run outcome='model' with kappa='batch': single impacts on Eq. 7 and Eq. 10;
+--outcome paper runs the paper's convention with its kappa 1): Emax/E50 = 4 in every
 single-particle run; 5 % of the Rayleigh time (RT) for the probabilities, 2 % for the
 fragmentation, 1 % in the cs and damping studies (its Figs. 18-19 captions); dmin = top size / 20, emin = 1e-4 J, kappa = 1, cs = 0;
 global damping from each material file (0.3 copper ore, 0 otherwise); 5.5 mm particles for the
@@ -37,10 +39,12 @@ Figures (--figures, comma-separated):
                kinetic energy split into where it ends, per breakage generation and in total
                (energy_audit.py; YADE's energy tracking on, in this process).
 
---quick 1: copper ore only, few particles, 2-3 energies (Figs. 9-10: one level, the 50 %; Fig.
-11: 5 impacts, gamma 5 and 10; Figs. 13-19: 2 particles at 1000 J/kg, 2 % RT, 1 in Fig. 15)
-(tests/test_verify.py; 20 s with --jobs 2). The whole command: docs/verification.md (29 minutes
-with --jobs 2 on a quiet 2-core machine).
+Each point of Figs. 13-19 pools the scenes of every seed (--seeds), its particles per seed sized
+from the model's probability so that --broken particles break (fragmentation.particles_per_seed).
+
+--quick 1: copper ore only, the first seed, few particles, 2-3 energies (Figs. 9-10: one level,
+the 50 %; Fig. 11: 5 impacts, gamma 5 and 10; Figs. 13-19: 2 particles at 1000 J/kg, 2 % RT, 1
+in Fig. 15) (tests/test_verify.py). The whole command: docs/verification.md.
 Every run is a set of scenes (scenes.run_scenes of an impact_spec or, for the drop weight, a
 drop_weight_spec; Fig. 11: scenes.impact_scene and impact_again, in this process); the results are
 model.reports.breakage_result_of dicts, written to <out>/results.json with their settings. YADE
@@ -60,8 +64,8 @@ from yadebreak.options.flags import (integer, jobs_option, numbers, out_option, 
                                      text)
 from yadebreak.studies.verify import energy_audit, fragmentation, probability
 from yadebreak.studies.verify.report import write_report
-from yadebreak.studies.verify.settings import (PAPER_MATERIALS, Runner, paper_material, plan,  # noqa: F401
-                       probability_energies)
+from yadebreak.studies.verify.settings import (PAPER_MATERIALS, Runner,  # noqa: F401
+                                               paper_material, plan, probability_energies)
 
 #: figure name -> the function that runs it and returns its report entry, in report order
 FIGURES = {"probability": probability.figure_probability,
@@ -77,17 +81,28 @@ DEFAULT_FIGURES = list(FIGURES)
 
 #: attach() options the command exposes for the fragmentation figures (Figs. 13-19), beyond
 #: the paper's settings (studies.verify.settings.PAPER)
-FRAGMENTATION = ("read_period", "kappa_successive", "break_at", "t10_energy", "dummy_stiffness",
-                 "contact_energy_at_break")
+FRAGMENTATION = ("read_period", "outcome", "kappa", "kappa_successive", "break_at",
+                 "t10_energy", "dummy_stiffness", "contact_energy_at_break")
 #: the command's defaults that differ from attach()'s
-OVERRIDES = {"time_step_fraction": Override(
-    Derived("the paper's per figure: 5 % (Figs. 8-11), 2 % (13-16), 1 % (17-19)", token=0.0),
-    "the paper's Section 3 and the captions of its Figs. 18-19")}
+OVERRIDES = {
+    "time_step_fraction": Override(
+        Derived("the paper's per figure: 5 % (Figs. 8-11), 2 % (13-16), 1 % (17-19)", token=0.0),
+        "the paper's Section 3 and the captions of its Figs. 18-19"),
+    "outcome": Override("model", "with it and the batch kappa single impacts meet Eq. 7 and "
+                                 "Eq. 10 at every point of Figs. 13-16 (docs/verification.md); "
+                                 "'paper' runs the paper's convention"),
+    "kappa": Override(Derived("'batch' with --outcome model, 1 (the paper's Section 3) with "
+                              "--outcome paper",
+                              lambda args: "batch" if args.outcome == "model" else 1.0,
+                              token="outcome"),
+                      "the paper defines kappa as what makes Eq. 8's mean over the broken "
+                      "particles Eq. 7 (its Section 2.2) and ran kappa = 1")}
 
 
 def fragmentation_options(args):
     """attach() options of the fragmentation figures from the command's flags."""
-    return attach_options(args, FRAGMENTATION, {})
+    return attach_options(args, FRAGMENTATION,
+                          {k: o for k, o in OVERRIDES.items() if k in FRAGMENTATION})
 
 
 PARAMS = [
@@ -104,10 +119,16 @@ PARAMS = [
     text("audit_energies", "target", "the energy audit's energies: 'target', 150 and 1000 J/kg "
          "where Eq. 7 is at most 20 % (the cases of docs/verification.md's target); or J/kg, "
          "comma-separated, every material at each", empty=False),
-    integer("particles", 8, "particles per point in Figs. 13-19 (quick: 2)", lo=1),
+    integer("particles", 8, "the least particles per point and seed in Figs. 13-19 (quick: 2)",
+            lo=1),
+    integer("broken", 20, "Figs. 13-19: each point's particles per seed are sized from the "
+            "model's breakage probability so that this many break over the seeds (expected, less "
+            "two binomial standard deviations; at most 500 per seed; quick: not sized)", lo=1),
     integer("probability_particles", 250, "particles per point in Figs. 8-11 (the paper's "
             "250; quick: 40)", lo=1),
-    integer("seed", 3, "seed of every run (scene k of a run: scenes.scene_seed)", lo=0),
+    text("seeds", "3,4,5", "seeds, comma-separated: Figs. 13-19 pool the scenes of each (scene "
+         "k of seed s: scenes.scene_seed(s, k)); Figs. 8-11, the energy audit and --quick 1 "
+         "take the first", empty=False),
     *(engine_flag(name, OVERRIDES, "Figs. 13-19: " if name in FRAGMENTATION else "")
       for name in ("time_step_fraction", *FRAGMENTATION)),
     jobs_option("YADE processes sharing each run's scenes"),
@@ -144,6 +165,16 @@ def verify(args):
                  "energies > 0 J/kg, comma-separated")
     if args.read_period not in ("every_step", "fast"):
         fail(f"--read-period = {args.read_period}: accepted every_step or fast")
+    given = args.seeds
+    try:
+        args.seeds = tuple(int(v) for v in str(given).split(",") if v.strip())
+    except ValueError:
+        args.seeds = ()
+    if not args.seeds or min(args.seeds) < 0 or len(set(args.seeds)) < len(args.seeds):
+        fail(f"--seeds = {given}: accepted distinct integers >= 0, comma-separated")
+    if args.quick:
+        args.seeds = args.seeds[:1]
+    args.seed = args.seeds[0]                 # Figs. 8-11 and the energy audit
     args.argv = getattr(args, "argv", None) or sys.argv[2:]
     for name in args.material_list:           # a bad name stops here, before any run
         try:

@@ -199,7 +199,7 @@ def audit_task(name, energy, particles, seed, options):
     key = json.dumps(["energy_audit", name, energy, particles, seed, sorted(options.items())])
     spec = {"task": f"{__name__}:audit_scene", "counts": [1] * particles, "material": name,
             "size": FRAGMENT_SIZE, "energy": energy, "seed": seed, "options": options}
-    like = Run(name, FRAGMENT_SIZE, [energy], particles, seed, options)
+    like = Run(name, FRAGMENT_SIZE, [energy], particles, (seed,), options)
     return Task(key, spec, AUDIT_COST * run_cost(like, energy))
 
 

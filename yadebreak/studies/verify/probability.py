@@ -92,9 +92,9 @@ def figure_probability(args, runner, out):
     runs = []
     for name in args.material_list:
         energies = probability_energies(paper_material(name), PROBABILITY_SIZE, levels, steel)
-        runs += [Run(name, PROBABILITY_SIZE, energies, n, args.seed, options,
+        runs += [Run(name, PROBABILITY_SIZE, energies, n, (args.seed,), options,
                      per_scene=min(n, 50)),
-                 Run(name, PROBABILITY_SIZE, energies, n, args.seed, options, per_scene=n,
+                 Run(name, PROBABILITY_SIZE, energies, n, (args.seed,), options, per_scene=n,
                      test="drop_weight")]
     results = runner.run_all(runs)
     single = dict(zip(args.material_list, results[0::2]))
@@ -185,7 +185,7 @@ def figure_targets(args, runner, out):
                for label, target, seed_offset in fig9_targets(out)]
     by_target = runner.run_all([Run(
         COPPER_ORE, PROBABILITY_SIZE, probability_energies(mat, PROBABILITY_SIZE, levels, partner),
-        n, args.seed + seed_offset, options, per_scene=min(n, 50), target=target)
+        n, (args.seed + seed_offset,), options, per_scene=min(n, 50), target=target)
         for _, target, seed_offset, partner in targets])
     series = [(label, partner, results)
               for (label, _, _, partner), results in zip(targets, by_target)]
@@ -238,7 +238,7 @@ def figure_sizes(args, runner, out):
     mat = paper_material(COPPER_ORE)
     runs = [Run(COPPER_ORE, size, probability_energies(
         mat, size, QUICK_LEVELS if args.quick and size == PROBABILITY_SIZE else levels, steel),
-        n, args.seed, options, per_scene=min(n, 50)) for size in sizes]   # quick 5.5 mm: Fig. 8's
+        n, (args.seed,), options, per_scene=min(n, 50)) for size in sizes]   # quick 5.5 mm: Fig. 8's
     by_size = runner.run_all(runs)
     plt = report.plt_module()
     fig, ax = plt.subplots(figsize=(10, 5.2))

@@ -23,16 +23,21 @@ from pathlib import Path
 
 #: reading -> (verify's flags, the sentence or option it reads)
 READINGS = {
-    "paper": ((), "the paper's convention: breakage where the energy first passes the fracture "
+    "paper": (("--outcome", "paper"), "the paper's convention: breakage where the energy first passes the fracture "
                   "energy, t10' of Eq. 8 there, the fragments' overlaps zeroed"),
-    "carried": (("--contact-energy-at-break", "carried"),
+    "carried": (("--outcome", "paper", "--contact-energy-at-break", "carried"),
                 "the paper, Section 1: successive events 'if there is still energy remaining in "
                 "the contact after the primary breakage event'"),
-    "e50b": (("--t10-energy", "e50b"),
+    "e50b": (("--outcome", "paper", "--t10-energy", "e50b"),
              "the Rocky manual, Eqs. 2-47/2-48: 'Energy for t10 Calculation' set to the median "
              "specific fracture energy (e50b)"),
-    "peak": (("--break-at", "peak"),
+    "peak": (("--outcome", "paper", "--break-at", "peak"),
              "beyond the sources: breakage at the stressing event's peak (for comparison)"),
+    "model": (("--outcome", "model", "--kappa", "1"),
+              "outcome='model': t10' of Eq. 8 at the stressing event's whole energy (its "
+              "peak), the dummies' fines spread by Eq. 10 (docs/model.md)"),
+    "model_batch": (("--outcome", "model", "--kappa", "batch"),
+                    "outcome='model' with the paper's definition of kappa (Section 2.2)"),
 }
 #: the Fig. 16 set: material groups run together and their energies (J/kg)
 CASES = (("copper_ore,granulite,limestone", "150,300,1000,3000"),)
@@ -58,7 +63,7 @@ def run_all(out, readings, seeds, cases, jobs):
                     continue
                 folder.parent.mkdir(parents=True, exist_ok=True)
                 cmd = [sys.executable, "-m", "yadebreak", "verify", "--figures", "t10",
-                       "--materials", materials, "--energies", energies, "--seed", str(seed),
+                       "--materials", materials, "--energies", energies, "--seeds", str(seed), "--broken", "1",
                        "--jobs", str(jobs), "--out", str(folder), "--overwrite", "1",
                        *READINGS[reading][0]]
                 print(f"[readings] {reading}, seed {seed}: {' '.join(cmd[3:])}", flush=True)
@@ -83,7 +88,7 @@ def pool(runs):
     broke = [(w, r) for w, r in zip(weights, runs) if w > 0 and r["t10_simulated"] is not None]
     total = sum(w for w, _ in broke)
     point = {"particles": sum(r["particles"] for r in runs), "broken": total,
-             "seeds": sorted(r["seed"] for r in runs), "t10_model": runs[0]["t10_model"],
+             "seeds": sorted(s for r in runs for s in r["seeds"]), "t10_model": runs[0]["t10_model"],
              "breakages": sum(r["breakage_events_all_generations"] for r in runs)}
     if not total:
         return {**point, "t10": None, "t10_se": None, "passing": None}

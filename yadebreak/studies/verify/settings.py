@@ -36,24 +36,26 @@ PAPER_DEFAULTS = ("cs", "emin", "dmin")
 @dataclasses.dataclass
 class Run:
     """One set of impacts: `particles` particles of `material` (name) and `size` (m) at each
-    energy, with attach() options; `test` "single" (fired at the target) or "drop_weight" (a
-    steel striker 50 times the particle's mass falls on it on a steel anvil: the paper's DWT);
-    `per_scene` particles (strikers) side by side in each scene, scene k seeded
-    scenes.scene_seed(seed, k)."""
+    energy and each of `seeds`, with attach() options; `test` "single" (fired at the target) or
+    "drop_weight" (a steel striker 50 times the particle's mass falls on it on a steel anvil:
+    the paper's DWT); `per_scene` particles (strikers) side by side in each scene, scene k of
+    seed s seeded scenes.scene_seed(s, k). The seeds' scenes are pooled into one result."""
 
     material: str
     size: float
     energies: list
     particles: int
-    seed: int
+    seeds: tuple
     options: dict
     per_scene: int = 1
     target: str = "steel"
     test: str = "single"
 
-    def key(self, energy):
-        return json.dumps([self.material, self.size, energy, self.particles, self.seed,
-                           self.target, self.test, sorted(self.options.items())])
+    def key(self, energy, seed=None):
+        """The result's key at `energy`: of one seed's scenes, or (seed None) of all pooled."""
+        return json.dumps([self.material, self.size, energy, self.particles,
+                           list(self.seeds) if seed is None else seed, self.target, self.test,
+                           sorted(self.options.items())])
 
 
 def paper_material(name):
@@ -109,17 +111,29 @@ class Runner:
         return self.run_all([run])[0]
 
     def run_all(self, runs):
-        """The results of each run (a list per run, one result per energy), run together."""
+        """The results of each run (a list per run, one result per energy: its seeds' scenes
+        pooled), run together."""
         self.queue(runs)
-        each = _each(runs)
-        for key, (run, energy) in each.items():  # jobs 1: here
-            if key not in self._queued and key not in self.results:
-                self._keep(run, energy, _tally_here(run, energy))
-        for key, (run, energy) in each.items():
-            if key in self._queued:
-                self._keep(run, energy, self._pool.collect(self._queued.pop(key),
-                                                           on_wait=_waiting(run, energy)))
+        for run in runs:
+            for energy in run.energies:
+                if run.key(energy) not in self.results:
+                    self._keep(run, energy, self._pooled(run, energy))
         return [[self.results[run.key(energy)] for energy in run.energies] for run in runs]
+
+    def _pooled(self, run, energy):
+        """The tally of the run's scenes at `energy` over its seeds (in the pool, or here)."""
+        tally = None
+        for seed in run.seeds:
+            key = run.key(energy, seed)
+            if key in self._queued:
+                one = self._pool.collect(self._queued.pop(key), on_wait=_waiting(run, energy))
+            else:
+                one = _tally_here(run, energy, seed)
+            if tally is None:
+                tally = one
+            else:
+                tally.merge(one)
+        return tally
 
     def run_tasks(self, tasks):
         """What each Task's scenes returned (a list per task, in scene order; kept apart from
@@ -140,8 +154,8 @@ class Runner:
         if self.jobs <= 1:
             return
         impacts = [r for r in runs if not isinstance(r, Task)]
-        todo = [(key, run_cost(run, energy), (run, energy))
-                for key, (run, energy) in _each(impacts).items()]
+        todo = [(key, run_cost(run, energy), (run, energy, seed))
+                for key, (run, energy, seed) in _each(impacts).items()]
         todo += [(t.key, t.cost, t) for t in runs if isinstance(t, Task)]
         for key, _, what in sorted(todo, key=lambda item: -item[1]):
             if key in self.results or key in self.returned or key in self._queued:
@@ -176,7 +190,7 @@ class Runner:
         result.update(steps=tally.steps, scenes_at_step_limit=tally.scenes_at_step_limit,
                       wall_s=tally.scene_wall_s, yade_engines_s=tally.yade_engines_s,
                       material=mat.name, size=run.size,
-                      options=run.options, seed=run.seed, test=run.test)
+                      options=run.options, seeds=list(run.seeds), test=run.test)
         self.results[run.key(energy)] = result
         progress(f"{mat.name} {1e3 * run.size:g} mm {run.test} "
                  f"{_settings_short(run.options)}: "
@@ -223,8 +237,9 @@ def plan(figures, args, out):
 
 
 def _each(runs):
-    """{key: (run, energy)} of every energy of `runs`, once each."""
-    return {run.key(energy): (run, energy) for run in runs for energy in run.energies}
+    """{key: (run, energy, seed)} of every energy and seed of `runs`, once each."""
+    return {run.key(energy, seed): (run, energy, seed) for run in runs
+            for energy in run.energies for seed in run.seeds}
 
 
 def run_cost(run, energy):
@@ -259,23 +274,23 @@ def _waiting(run, energy):
 DROP_WEIGHT_MAX_TIME = 0.05
 
 
-def _spec(run, energy):
-    """The run's scenes at `energy` as a spec of scenes.run_scenes (a pool's or this
+def _spec(run, energy, seed):
+    """The run's scenes at `energy` of `seed` as a spec of scenes.run_scenes (a pool's or this
     process's)."""
     from yadebreak import scenes
     if run.test == "drop_weight":
         return scenes.drop_weight_spec(run.material, run.size, energy, run.particles,
-                                       run.per_scene, run.seed, DROP_WEIGHT_MAX_TIME,
+                                       run.per_scene, seed, DROP_WEIGHT_MAX_TIME,
                                        **run.options)
     return scenes.impact_spec(run.material, run.size, float(np.sqrt(2.0 * energy)), run.particles,
-                              run.per_scene, run.seed, target=run.target,
+                              run.per_scene, seed, target=run.target,
                               wait_for_arrivals=True, **run.options)
 
 
-def _tally_here(run, energy):
-    """A run's scenes in this process (jobs 1): the same tally as the pool's."""
+def _tally_here(run, energy, seed):
+    """A run's scenes of one seed in this process (jobs 1): the same tally as the pool's."""
     from yadebreak import scenes
-    spec = _spec(run, energy)
+    spec = _spec(run, energy, seed)
     tally, _ = scenes.run_scenes(spec, range(len(spec["counts"])))
     return tally
 
@@ -286,26 +301,40 @@ def _settings_short(options):
             f"{'file' if gd is None else f'{gd:g}'}")
 
 
-def settings_text(options, material_names, size, particles, seed, extra="", damping=None,
+def _kappa_text(kappa):
+    if kappa == "batch":
+        return "beyond the paper's kappa 1: kappa of Eq. 7's batch at each breakage, "
+    return "kappa of each material file, " if kappa is None else f"kappa {kappa:g}, "
+
+
+def settings_text(options, material_names, size, particles, seeds, extra="", damping=None,
                   target="steel"):
-    """One line of a figure's settings; `damping` (text) replaces the files' global damping;
-    `size` in m or a text (several sizes), `target` the text after "on"."""
+    """One line of a figure's settings; `seeds` one seed or a tuple of them (pooled);
+    `damping` (text) replaces the files' global damping; `size` in m or a text (several
+    sizes), `target` the text after "on"; `particles` per seed, a number or a text."""
     gd = options.get("global_damping")
     if damping is None:
         damping = ("each material file's (" + ", ".join(
             f"{n} {load_material(n).global_damping:g}" for n in material_names) + ")"
                    if gd is None else f"{gd:g}")
     size = size if isinstance(size, str) else f"{1e3 * size:g} mm"
-    return (f"{size} on {target}, {particles} particles per point, seed {seed}; "
+    seeds = (seeds,) if isinstance(seeds, int) else tuple(seeds)
+    seeds = (f"seed {seeds[0]}" if len(seeds) == 1 else
+             "seeds " + ", ".join(map(str, seeds)) + " pooled")
+    outcome = options.get("outcome", OPTION["outcome"].default)
+    return (f"{size} on {target}, {particles} particles per point and seed, {seeds}; "
             f"Emax/E50 {EMAX_RATIO:g}, time step {100 * options['time_step_fraction']:g} % of "
             f"the Rayleigh time, dmin = {OPTION['dmin'].none}, emin {options['emin']:g} J, "
-            f"kappa {options['kappa']:g}, cs {options['cs']:g}, global damping {damping}, "
+            + _kappa_text(options["kappa"])
+            + f"cs {options['cs']:g}, global damping {damping}, "
             f"contacts read "
             f"{'every step' if options['read_period'] == 'every_step' else 'in fast mode'}"
             + ("" if options.get("replace", True) else ", broken particles not replaced")
             + (f"; beyond the paper: kappa {options['kappa_successive']:g} for fragments"
                if options.get("kappa_successive") else "")
-            + ("; beyond the paper: breakage at the stressing event's peak (t10' of its "
+            + ("; outcome 'model': breakage at the stressing event's peak (t10' of its "
+               "whole energy), the dummies' fines spread by Eq. 10" if outcome == "model" else
+               "; beyond the paper: breakage at the stressing event's peak (t10' of its "
                "largest energy)" if options.get("break_at") == "peak" else "")
             + ("; beyond the paper: t10' over E50b of the energy absorbed at the break "
                "(Rocky's e50b option)" if options.get("t10_energy") == "e50b" else "")
