@@ -157,9 +157,10 @@ OPTIONS = (
          "Eq. 8 at the read where the energy first passes the fracture energy and the dummies' "
          "fines spread by Eqs. 11-12 (the paper's Fig. 17 text and Section 2.4); 'model', t10' "
          "of Eq. 8 at the whole stressing event's energy (break_at='peak') and the fines spread "
-         "by Eq. 10, so that one breakage's product is Eq. 10 at its t10' and single impacts "
-         "follow Eq. 7 (Eq. 8 with kappa 1 at each particle's whole share of the impact); "
-         "'model' refuses break_at='threshold' and t10_energy='e50b'",
+         "by Eq. 10, so that one breakage's product is Eq. 10 at its t10' (with kappa='batch' "
+         "single impacts then follow Eq. 7; with kappa 1, Eq. 8's mean over the broken, up to "
+         "exp(sigma^2/2) above it); 'model' refuses break_at='threshold' and "
+         "t10_energy='e50b'",
          words=tuple(OUTCOMES)),
     _row("break_at", "criteria", None, "choice", "-",
          "when a body breaks and which energy gives its t10' (Eq. 8): 'threshold' at the read "

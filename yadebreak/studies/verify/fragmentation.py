@@ -104,7 +104,7 @@ def _with_file_damping(options, name):
 # -- checks ------------------------------------------------------------------------------------
 def t10_check(name, size, r):
     """Eq. 7's t10 within T10_TOLERANCE of it plus STANDARD_ERRORS standard errors, at every
-    point where a particle broke (a point of one broken scene has no standard error: 0)."""
+    point (not met where nothing broke; a point of one broken scene has no standard error: 0)."""
     sim, mod = r.get("t10_simulated"), r.get("t10_model")
     if not mod:
         return None
