@@ -49,7 +49,7 @@ if a.coverage:
     hits, reps, t0 = dict.fromkeys(names, 0), 0, time.process_time()
     for k, name in enumerate(("copper_ore", "granulite", "limestone_2", "iron_ore_1")):
         mat = load_material(name)
-        truth = {"e_inf": mat.e_inf, "d0": mat.d0 * 1e3, "phi": mat.phi, "sigma": mat.sigma}
+        truth = {"e_inf": mat.params.e_inf, "d0": mat.params.d0 * 1e3, "phi": mat.params.phi, "sigma": mat.params.sigma}
         rng = np.random.default_rng(1000 + k)
         for _ in range(a.coverage):
             rows = np.array(examples.fracture_rows(mat, rng, (2.0, 5.0, 12.0, 30.0), 40,
@@ -58,7 +58,7 @@ if a.coverage:
                                                   "broken": rows[:, 2]},
                                np.arange(len(rows)) + 2, {})
             est = fracture.fit_fracture(table, fracture.Device(mat.hertz_stiffness),
-                                        {"emax_ratio": mat.emax_ratio}).result.estimates
+                                        {"emax_ratio": mat.params.emax_ratio}).result.estimates
             for n in names:
                 hits[n] += est[n].lo <= truth[n] <= est[n].hi
             reps += 1

@@ -118,7 +118,7 @@ def event_table():
         for v in victims[:5]:
             mat = brk.material["ore"]
             # ratio whose Eq. 8 gives t10' = 10 %
-            ratio = -mat.kappa / mat.b_prime * np.log(1 - 10.0 / mat.A)
+            ratio = -mat.params.kappa / mat.params.b_prime * np.log(1 - 10.0 / mat.params.A)
             before = brk.wall_time["replace"]
             ev = brk.break_body(v, ratio=ratio)
             own.append(brk.wall_time["replace"] - before)

@@ -15,10 +15,10 @@ from yadebreak import load_material  # noqa: E402
 
 for name in ("copper_ore", "limestone", "granulite", "iron_ore_1"):
     mat = load_material(name)
-    seconds = families.build_time(mat.beta_params, mat.t10_min, mat.A)
-    table = families.FamilyTable(mat.beta_params, mat.t10_min, mat.A)
+    seconds = families.build_time(mat.beta_params, mat.t10_min, mat.params.A)
+    table = families.FamilyTable(mat.beta_params, mat.t10_min, mat.params.A)
     rng = np.random.default_rng(0)
-    t10 = rng.uniform(mat.t10_min, mat.A, 20000)
+    t10 = rng.uniform(mat.t10_min, mat.params.A, 20000)
     start = time.perf_counter()
     for t in t10:
         table.draw(rng, t)

@@ -20,7 +20,7 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 from yadebreak.studies.grinding import (BatchGrinder, feed_masses, root2_classes,  # noqa: E402
                                 synthetic_spectra)
-from yadebreak.model.materials import load_material  # noqa: E402
+from yadebreak.criteria import load_material  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__)
 parser.add_argument("--material", default="copper_ore")

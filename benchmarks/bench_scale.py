@@ -199,7 +199,7 @@ def event_cost(sizes):
         for dummies in ("spheres", "ledger"):
             brk, _ = prepare("dense", n, "default", dummies=dummies)
             mat = brk.material["ore"]
-            ratio = -mat.kappa / mat.b_prime * np.log(1 - 10.0 / mat.A)   # Eq. 8 at 10 %
+            ratio = -mat.params.kappa / mat.params.b_prime * np.log(1 - 10.0 / mat.params.A)   # Eq. 8 at 10 %
             tracked = sorted(brk.state.tracked)
             victims = [tracked[len(tracked) // 2 + 7 * k] for k in range(7)]
             brk.break_body(victims[0], ratio=ratio)      # the first lowers O.dt: not counted

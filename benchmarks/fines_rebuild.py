@@ -15,7 +15,7 @@ import numpy as np
 sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 
 from yadebreak.model import families  # noqa: E402
-from yadebreak.model.materials import load_material  # noqa: E402
+from yadebreak.criteria import load_material  # noqa: E402
 
 
 def rebuilt_t10(fset, beta_params, fines):
@@ -34,7 +34,7 @@ for name in args.materials.split(","):
     mat = load_material(name)
     table = families.table_for(mat)
     for t in (float(v) for v in args.t10.split(",")):
-        if not mat.t10_min <= t <= mat.A:
+        if not mat.t10_min <= t <= mat.params.A:
             continue
         fset = table.sets[table.nearest(t)]
         gs, e10 = (rebuilt_t10(fset, mat.beta_params, f) for f in ("gaudin_schuhmann", "eq10"))

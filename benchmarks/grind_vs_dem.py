@@ -47,7 +47,7 @@ from yadebreak import model  # noqa: E402
 from yadebreak.model import families, milling  # noqa: E402
 from yadebreak.studies.grinding import (BatchGrinder, feed_masses, from_mill_run,  # noqa: E402
                                 root2_classes)
-from yadebreak.model.materials import load_material  # noqa: E402
+from yadebreak.criteria import load_material  # noqa: E402
 
 parser = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -173,7 +173,7 @@ def compare(spectra_run, dem_run, material, t10_at="collision", with_dmin=False,
     times = table[:, 0]
     with tempfile.TemporaryDirectory() as folder:
         counted = window_spectra(spectra_run, times[-1], folder)
-        spectra = from_mill_run(folder)
+        spectra = from_mill_run(folder, load_material)
     dem_sieves = np.array([float(h.split("_")[1][:-2]) * 1e-3 for h in header[1:]])
     dem_passing = table[:, 1:]
     d0 = dem["size"]
@@ -365,7 +365,7 @@ def _model_by_class(spectra_run, dem_run, material, sieve):
     t_end, d0, charge = dem["simulated_time"], dem["size"], dem["initial_mass"]
     with tempfile.TemporaryDirectory() as folder:
         window_spectra(spectra_run, t_end, folder)
-        spectra = from_mill_run(folder)
+        spectra = from_mill_run(folder, load_material)
     classes = root2_classes(d0 * 2 ** 0.25, 16)
     masses, fines = feed_masses(classes, d0, charge)
     out = {}

@@ -115,7 +115,7 @@ def test_breakage_against_uniform_strengths_follows_p_of_e_cum():
 
 # ----------------------------------------------------------------------------- material files
 def test_example_material_loads_and_dispatches():
-    assert AB.is_ab_t10 and AB.size_ref == pytest.approx(0.01) and AB.t10_max == 50.0
+    assert AB.is_ab_t10 and AB.params.size_ref == pytest.approx(0.01) and AB.params.t10_max == 50.0
     assert AB.min_energy(SIZE) == pytest.approx(40.0 * 10.0 / 5.5)
     e = np.linspace(0, 1000, 50)
     assert np.allclose(AB.fracture_energy_cdf(e, SIZE),
@@ -188,7 +188,7 @@ def test_repeated_impacts_accumulate_and_follow_the_closed_form(scene):
         got.append(1 - len(alive) / n)
     absorbed = AB.energy_partition(STEEL) * energy
     expected = model.ab_t10_repeated_broken_fraction(absorbed, SIZE, AB.min_energy(SIZE),
-                                                     AB.selection, AB.size_ref, impacts)
+                                                     AB.params.selection, AB.params.size_ref, impacts)
     sigma = np.sqrt(expected * (1 - expected) / n)
     assert np.all(np.abs(np.array(got) - expected) <= 3 * sigma + 0.01)
     assert got[-1] > 2 * got[0]

@@ -6,8 +6,8 @@ import pytest
 from scipy import stats
 
 from yadebreak.model import bonds
-from yadebreak.model.materials import (MATERIALS_DIR, MaterialError, available_materials,
-                                 load_material)
+from yadebreak.model.materials import MATERIALS_DIR, MaterialError, available_materials
+from yadebreak.criteria import load_material
 
 E, NU = 3e9, 0.4
 

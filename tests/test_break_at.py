@@ -30,7 +30,7 @@ def test_at_the_peak_each_particle_breaks_with_its_share_of_the_impact_energy():
         # fast reads: the peak read within their 2 % tolerance of the fracture energy, and the
         # normal dashpot and the first steps' work within 1 % more
         assert e["specific_energy"] == pytest.approx(share, rel=0.03)
-        assert e["t10"] == pytest.approx(cu.A * (1 - np.exp(-cu.b_prime * e["ratio"] / cu.kappa)))
+        assert e["t10"] == pytest.approx(cu.params.A * (1 - np.exp(-cu.params.b_prime * e["ratio"] / cu.params.kappa)))
         assert e["ratio"] > 1.0
 
 
@@ -62,11 +62,11 @@ def test_t10_energy_e50b_gives_eq7_over_e50b_of_the_energy_absorbed_at_the_break
     assert len(broken) == 4
     for e in broken:
         size = 2.0 * e["radius"]
-        e50 = model.median_fracture_energy(size, cu.e_inf, cu.d0, cu.phi, cu.hertz_stiffness,
-                                           cu.device_stiffness)
-        e50b = model.median_fracture_energy_broken(e["specific_energy"], e50, cu.sigma,
-                                                   cu.emax_ratio)
+        e50 = model.median_fracture_energy(size, cu.params.e_inf, cu.params.d0, cu.params.phi, cu.hertz_stiffness,
+                                           cu.params.device_stiffness)
+        e50b = model.median_fracture_energy_broken(e["specific_energy"], e50, cu.params.sigma,
+                                                   cu.params.emax_ratio)
         assert e50b < e["specific_energy"]
-        expected = cu.A * (1.0 - np.exp(-cu.b_prime * e["specific_energy"] / e50b))
+        expected = cu.params.A * (1.0 - np.exp(-cu.params.b_prime * e["specific_energy"] / e50b))
         assert e["t10"] == pytest.approx(expected, rel=1e-9)
         assert e["t10"] > default[e["id"]]["t10"]

@@ -23,7 +23,7 @@ import pytest
 from yadebreak import model
 from yadebreak.studies.calibration import (ab_t10, bootstrap, damage, data, examples, fit_all, fracture,
                                    progeny, t10)
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 from yadebreak.studies.calibration.mle import FitError
 
 REPO = Path(__file__).resolve().parent.parent
@@ -40,12 +40,12 @@ def table_of(kind, rows):
 
 
 def device_of(mat):
-    return fracture.Device(mat.hertz_stiffness, mat.device_stiffness)
+    return fracture.Device(mat.hertz_stiffness, mat.criterion.device_stiffness)
 
 
 def truth_of(mat):
-    return {"e_inf": mat.e_inf, "d0": mat.d0 * 1e3, "phi": mat.phi, "sigma": mat.sigma,
-            "emax_ratio": mat.emax_ratio, "gamma": mat.gamma, "A": mat.A, "b_prime": mat.b_prime}
+    return {"e_inf": mat.params.e_inf, "d0": mat.params.d0 * 1e3, "phi": mat.params.phi, "sigma": mat.params.sigma,
+            "emax_ratio": mat.params.emax_ratio, "gamma": mat.params.gamma, "A": mat.params.A, "b_prime": mat.params.b_prime}
 
 
 def covered(estimates, truth, names):
@@ -67,7 +67,7 @@ def test_fracture_energy_intervals_cover_the_truth():
         rows = examples.fracture_rows(mat, np.random.default_rng(100 + k), (2.0, 5.0, 12.0, 30.0),
                                       40, cap_quantile=0.95)
         fit = fracture.fit_fracture(table_of("fracture", rows), device_of(mat),
-                                    fixed={"emax_ratio": mat.emax_ratio})
+                                    fixed={"emax_ratio": mat.params.emax_ratio})
         for n, ok in covered(fit.result.estimates, truth_of(mat), hits).items():
             hits[n] += ok
     assert_coverage(hits, 25, lowest=21 / 25, highest=1.0)
@@ -127,11 +127,11 @@ def test_ab_t10_intervals_cover_the_truth():
     e_min,ref (chi-square 2)."""
     mat = load_material("ab_t10_ore")
     rng = np.random.default_rng(400)
-    truth = {"e_min_ref": mat.e_min_ref, "selection": mat.selection}
+    truth = {"e_min_ref": mat.params.e_min_ref, "selection": mat.params.selection}
     hits = {"e_min_ref": 0, "selection": 0}
     for _ in range(100):
         rows = examples.fracture_rows(mat, rng, (2.0, 5.0, 12.0, 30.0), 40)
-        result = ab_t10.fit_ab_t10(table_of("fracture", rows), device_of(mat), mat.size_ref * 1e3)
+        result = ab_t10.fit_ab_t10(table_of("fracture", rows), device_of(mat), mat.params.size_ref * 1e3)
         for n, ok in covered(result.estimates, truth, hits).items():
             hits[n] += ok
     assert_coverage(hits, 100)
@@ -170,11 +170,11 @@ def test_table4_and_e50b_from_the_paper():
     tab = table_of("t10", [(5.0, e, 0.0) for e in energies])
     e50b_rows, _ = t10.e50b(tab, paper, dev)
     assert e50b_rows[1] == pytest.approx(258.0, abs=0.2)
-    tab.columns["t10"][:] = model.t10_batch(energies, e50b_rows, mat.A, mat.b_prime)
+    tab.columns["t10"][:] = model.t10_batch(energies, e50b_rows, mat.params.A, mat.params.b_prime)
     tab.columns["t10"][:] += np.array([0.1, -0.1, 0.1, -0.1, 0.1, -0.1])   # RSS > 0
     est = t10.fit_t10(tab, paper, dev).estimates
-    assert est["A"].lo < mat.A < est["A"].hi and est["b_prime"].lo < mat.b_prime < est["b_prime"].hi
-    assert est["A"].value == pytest.approx(mat.A, rel=0.02)
+    assert est["A"].lo < mat.params.A < est["A"].hi and est["b_prime"].lo < mat.params.b_prime < est["b_prime"].hi
+    assert est["A"].value == pytest.approx(mat.params.A, rel=0.02)
 
 
 def test_bootstrap_intervals_agree_with_the_profile_ones():
@@ -280,7 +280,7 @@ def test_t10_and_gamma_need_more_than_one_level():
     """A and b' from one energy level (here repeated thrice), gamma from first impacts only: the
     relation is not determined and the fit says which data are missing."""
     mat = load_material("copper_ore")
-    frac = {k: getattr(mat, k) * (1e3 if k == "d0" else 1.0)
+    frac = {k: getattr(mat.params, k) * (1e3 if k == "d0" else 1.0)
             for k in ("e_inf", "d0", "phi", "sigma", "emax_ratio")}
     one_level = table_of("t10", [[10.0, 500.0, 20.0], [10.0, 500.0, 22.0], [10.0, 500.0, 21.0]])
     with pytest.raises(FitError, match="A, b_prime: 1 energy levels"):
@@ -320,7 +320,7 @@ def test_cli_writes_a_loadable_material_with_intervals(tmp_path):
     fit = json.loads((tmp_path / "fit.json").read_text())
     for key in ("e_inf", "d0", "phi", "sigma", "emax_ratio", "gamma", "A", "b_prime"):
         entry = fit["parameters"][key]
-        assert entry["estimate"] == pytest.approx(getattr(mat, key) * (1e3 if key == "d0" else 1),
+        assert entry["estimate"] == pytest.approx(getattr(mat.params, key) * (1e3 if key == "d0" else 1),
                                                   rel=1e-5)
         lo, hi = entry["ci95"]
         assert lo <= entry["estimate"] and (hi is None or entry["estimate"] <= hi)

@@ -82,5 +82,5 @@ def test_carried_energy_counts_in_the_event_breaks_past_the_fracture_energy_and_
         judge.judge(Loading({}), 1, 1, False)          # unloaded: the event ends
         c = st.table.columns
         assert 0 not in st.open_events and c["carried"][0] == 0.0
-        after = float(model.weakened_fracture_energy(energy, 0.3, cu.gamma))
+        after = float(model.weakened_fracture_energy(energy, 0.3, cu.params.gamma))
         assert c["fracture_energy"][0] == pytest.approx(after, rel=1e-12)

@@ -3,7 +3,7 @@ split into where it ends closes to an integration error that shrinks with the ti
 sink with a closed form takes it."""
 import pytest
 
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 
 SPEED = 45.0                               # m/s: 1,012 J/kg
 

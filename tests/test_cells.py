@@ -7,7 +7,7 @@ from scipy.spatial import ConvexHull
 
 from yadebreak import model
 from yadebreak.model import cells
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 
 CUBE = np.array([[x, y, z] for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)])
 

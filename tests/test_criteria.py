@@ -5,7 +5,9 @@ import pytest
 from scipy import stats
 
 from yadebreak import criteria, load_material
-from yadebreak.model.materials import CRITERIA, available_materials
+from yadebreak.model.materials import available_materials
+from yadebreak.criteria import CRITERIA
+from yadebreak.criteria.base import registry
 
 SIZE = 5.5e-3          # m
 #: draws of the KS test: its critical distance at 1 % is 1.63 / sqrt(N) = 0.0073
@@ -27,7 +29,25 @@ def test_the_registry_holds_the_criteria_once():
     with pytest.raises(ValueError, match="criterion = 'nope': accepted 'tavares', 'ab_t10'"):
         criteria.criterion_class("nope")
     with pytest.raises(ValueError, match="registered twice"):
-        criteria.register(type("Again", (criteria.Criterion,), {"name": "tavares"}))
+        registry(criteria.Tavares, type("Again", (criteria.Criterion,), {"name": "tavares"}))
+
+
+@pytest.mark.parametrize("name", sorted(CRITERIA))
+def test_a_criterion_owns_its_keys_parameters_and_columns(name):
+    """Its Params has one field per [breakage] key; the keys fit calibrates are its own; its
+    per-body columns are not the shared ones; a shipped file read back in the file's units gives
+    the numbers written in it."""
+    import dataclasses
+    import tomllib
+    from yadebreak.engine.state import SHARED_COLUMNS
+    cls = CRITERIA[name]
+    assert {f.name for f in dataclasses.fields(cls.Params)} == cls.file_keys()
+    assert set(cls.calibrated) <= cls.file_keys()
+    assert not set(cls.columns) & set(SHARED_COLUMNS)
+    mat = _material_of(name)
+    written = tomllib.loads(open(mat.source, "rb").read().decode())["breakage"]
+    for key, value in cls.in_file_unit(mat.params).items():
+        assert value == pytest.approx(written.get(key, cls.key(key).default), rel=1e-12), key
 
 
 @pytest.mark.parametrize("name", sorted(CRITERIA))

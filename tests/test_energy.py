@@ -61,7 +61,7 @@ def test_subcritical_impact_weakens_by_eqs_5_6(scene):
     scenes.run_until_rebound(ids)
     (ev,) = [e for e in brk.events if e["kind"] == "damage"]
     ratio = ev["specific_energy"] / 50.0
-    expected = model.weakened_fracture_energy(50.0, ratio, load_material("copper_ore").gamma)
+    expected = model.weakened_fracture_energy(50.0, ratio, load_material("copper_ore").params.gamma)
     assert ev["fracture_energy_after"] == pytest.approx(float(expected), rel=1e-12)
     assert st.fracture_energy == pytest.approx(float(expected), rel=1e-12)
     assert st.damage == pytest.approx(1 - expected / 50.0, rel=1e-12)
@@ -160,8 +160,8 @@ def test_repeated_impacts_follow_the_damage_model(scene):
         got.append(1 - len(alive) / n)
     share = mat.energy_partition(load_material("steel"))
     expected = model.repeated_impact_broken_fraction(
-        share * energy, float(mat.median_fracture_energy(size)), mat.sigma, mat.emax_ratio,
-        mat.gamma, impacts)
+        share * energy, float(mat.median_fracture_energy(size)), mat.params.sigma, mat.params.emax_ratio,
+        mat.params.gamma, impacts)
     sigma = np.sqrt(expected * (1 - expected) / n)
     assert np.all(np.abs(np.array(got) - expected) <= 3 * sigma)
     assert got[-1] > 2 * got[0]             # damage matters: later impacts break more

@@ -13,7 +13,8 @@ from yadebreak.options import table as config
 from yadebreak import criteria
 from yadebreak.engine.contacts import ContactReader, Loading, Strongest
 from yadebreak.engine.state import (BREAKABLE, DUMMY, FORMAT_VERSION, UNBREAKABLE, BodyTable,
-                                      EngineState, FinesLedger, check_format)
+                                      EngineState, FinesLedger, SHARED_COLUMNS, assembled_columns,
+                                      check_format)
 
 
 # -- options ----------------------------------------------------------------------------------
@@ -82,6 +83,24 @@ def test_state_round_trip_continues_the_same_random_stream():
     assert back.total_mass() == st.total_mass() == pytest.approx(1e-3 + 2e-3 + 3e-3 + 1e-4 + 2e-5)
 
 
+def test_the_body_table_holds_the_columns_its_criteria_declare():
+    """Each criterion declares its per-body columns (Criterion.columns) and the table assembles
+    them: a Tavares scene keeps none of Ab-T10's; a state saved with more columns (an older
+    version kept every criterion's) restores into the table of the criteria present."""
+    cu, ab = (load_material(n).criterion for n in ("copper_ore", "ab_t10_ore"))
+    assert set(assembled_columns([cu])) == set(SHARED_COLUMNS)
+    both = assembled_columns([cu, ab])
+    assert set(both) == set(SHARED_COLUMNS) | set(ab.columns) == set(assembled_columns([ab]))
+    st = EngineState(["ore"], 0, columns=both)
+    st.table.add([2], BREAKABLE, "ore", 1e-3, 1e-3, e_cum=7.5)
+    data = json.loads(json.dumps(st.to_dict()))
+    assert EngineState.from_dict(data, columns=both).table[2].e_cum == 7.5
+    tavares_only = EngineState.from_dict(data, columns=assembled_columns([cu])).table
+    assert "e_cum" not in tavares_only.columns and tavares_only[2].mass == 1e-3
+    with pytest.raises(ValueError, match="column 'e_cum'"):
+        assembled_columns([ab, type("Other", (), {"columns": {"e_cum": (np.int8, 0)}})()])
+
+
 def test_saved_state_of_another_format_is_refused_with_its_version():
     data = _state().to_dict()
     data["format_version"] = FORMAT_VERSION + 1
@@ -102,7 +121,7 @@ def test_ledger_carries_mass_and_kinetic_energy():
 def _one_body(material_name, fracture_energy, mass=1e-4, size=5.5e-3):
     mat = load_material(material_name)
     crit = criteria.criterion_for(mat)
-    table = BodyTable(["ore"])
+    table = BodyTable(["ore"], assembled_columns([crit]))
     extra = {"e_min": float(mat.min_energy(size))} if isinstance(crit, criteria.AbT10) else {}
     table.add([0], BREAKABLE, "ore", mass, size / 2, fracture_energy=fracture_energy,
               fracture_energy_initial=fracture_energy, **extra)
@@ -125,14 +144,14 @@ def test_tavares_breaks_at_the_first_read_above_its_fracture_energy_and_is_weake
     mat, crit, table = _one_body("copper_ore", 200.0)
     assert _load(crit, table, np.linspace(0, 190, 20)) is None
     fields = crit.unload(table, 0)                       # the event ends at 190 J/kg
-    expected = float(model.weakened_fracture_energy(200.0, 190.0 / 200.0, mat.gamma))
+    expected = float(model.weakened_fracture_energy(200.0, 190.0 / 200.0, mat.params.gamma))
     assert fields["fracture_energy_after"] == pytest.approx(expected, rel=1e-12)
     assert table[0].damage == pytest.approx(1 - expected / 200.0, rel=1e-12)
     table[0].specific_energy = table[0].event_max = 0.0
     history = np.linspace(0, 2 * expected, 41)
     assert _load(crit, table, history) == int(np.argmax(history > expected))
     ratio, t10, _ = crit.breakage(table, 0, history[-1] * 1e-4)
-    assert t10 == pytest.approx(float(model.t10(ratio, mat.A, mat.b_prime, mat.kappa)))
+    assert t10 == pytest.approx(float(model.t10(ratio, mat.params.A, mat.params.b_prime, mat.params.kappa)))
 
 
 def test_ab_t10_accumulates_e_minus_e_min_per_loading_and_breaks_past_its_threshold():
@@ -223,7 +242,7 @@ def test_a_body_counts_its_share_of_a_contacts_work_since_its_offset_from_emin_o
 def _scene(seed):
     rng = np.random.default_rng(seed)
     mats = [load_material("copper_ore"), load_material("ab_t10_ore")]
-    st = EngineState(["cu", "ab"], seed)
+    st = EngineState(["cu", "ab"], seed, columns=assembled_columns(m.criterion for m in mats))
     n = 40
     ids = np.arange(n) * 2 + 1
     mat_index = rng.integers(0, 2, n)
@@ -291,11 +310,11 @@ def test_kappa_successive_sets_eq8_for_fragments_only():
               generation=np.array([0, 1]))
     ek = 1.7 * 2e-3 * 400.0                        # J: the ratio of Eq. 8 is 1.7 for both
     paper, successive = criteria.Tavares(cu), criteria.Tavares(cu, kappa_successive=0.5)
-    for crit, kappas in ((paper, (cu.kappa, cu.kappa)), (successive, (cu.kappa, 0.5))):
+    for crit, kappas in ((paper, (cu.params.kappa, cu.params.kappa)), (successive, (cu.params.kappa, 0.5))):
         for i, kappa in zip((0, 1), kappas):
             ratio, t10, _ = crit.breakage(table, i, ek)
             assert ratio == pytest.approx(1.7)
-            assert t10 == pytest.approx(cu.A * (1 - math.exp(-cu.b_prime * 1.7 / kappa)))
+            assert t10 == pytest.approx(cu.params.A * (1 - math.exp(-cu.params.b_prime * 1.7 / kappa)))
     cfg = config.Config.from_options(kappa_successive=0.5)
     assert cfg.criteria.kappa_successive == 0.5
     with pytest.raises(config.AttachError, match="kappa_successive"):
@@ -329,7 +348,7 @@ def test_break_at_peak_waits_for_the_event_to_stop_rising_and_takes_its_largest_
     assert found[True] == (3, pytest.approx(600.0 * mass))
     ratio, t10, _ = criteria.criterion_for(cu).breakage(st.table, 0, found[True][1])
     assert ratio == pytest.approx(1.5)
-    assert t10 == pytest.approx(float(model.t10(1.5, cu.A, cu.b_prime, cu.kappa)))
+    assert t10 == pytest.approx(float(model.t10(1.5, cu.params.A, cu.params.b_prime, cu.params.kappa)))
     with pytest.raises(config.AttachError, match="break_at"):
         config.Config.from_options(break_at="late")
 

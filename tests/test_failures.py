@@ -16,6 +16,7 @@ from yadebreak.analysis import reports
 from yadebreak.jobs import lifecycle
 from yadebreak.jobs.lifecycle import partial_outputs_on_failure, time_left
 from yadebreak.options import flags as options
+from yadebreak.process import signals
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -282,7 +283,7 @@ def test_a_signal_ends_the_run_as_interrupted_with_its_outputs(tmp_path, capsys)
     said = capsys.readouterr()
     assert said.err == "" and said.out.splitlines()[-1].startswith(
         "[yadebreak] interrupted (SIGTERM): ")       # (before it: YADE's greeting, if imported)
-    assert signal.getsignal(signal.SIGTERM) is not lifecycle._on_signal     # restored
+    assert signal.getsignal(signal.SIGTERM) is not signals.on_signal       # restored
 
 
 def test_a_second_signal_stops_at_once(tmp_path):
@@ -333,15 +334,18 @@ def test_ctrl_c_inside_a_pyrunner_ends_as_interrupted_not_as_a_pyrunner_error(sc
 def test_a_signal_wrapped_in_an_error_is_still_an_interruption(tmp_path):
     """A signal outside stop_points raises where it strikes; inside a PyRunner YADE turns it into a
     RuntimeError: the run still ends as interrupted."""
+    import os
     import signal
     written = []
-    lifecycle._STOP["signal"] = signal.SIGINT
+    handlers = signals.catch_signals()
     try:
+        with signals.stop_points():
+            os.kill(os.getpid(), signal.SIGINT)         # received: the run is asked to stop
         with pytest.raises(RuntimeError):
             with lifecycle.partial_outputs_on_failure(lambda *end: written.append(end)):
                 raise RuntimeError("PyRunner error.\nCOMMAND: ...\nKeyboardInterrupt")
     finally:
-        lifecycle._STOP["signal"] = None
+        signals.restore_signals(handlers)
     assert written == [("interrupted", "stopped by Ctrl-C, SIGINT")]
 
 

@@ -4,7 +4,8 @@ import pytest
 
 from yadebreak.model import families
 from yadebreak import model
-from yadebreak.model.materials import available_materials, load_material
+from yadebreak.model.materials import available_materials
+from yadebreak.criteria import load_material
 
 BREAKABLE = [n for n in available_materials() if load_material(n).breakable]
 
@@ -61,10 +62,10 @@ def test_at_least_as_close_as_the_paper_table2():
 def test_table_grid_keeps_t10_within_5_percent():
     mat = load_material("copper_ore")
     table = families.table_for(mat)
-    t = np.geomspace(mat.t10_min, mat.A, 500)
+    t = np.geomspace(mat.t10_min, mat.params.A, 500)
     nearest = table.grid[[table.nearest(v) for v in t]]
     assert np.abs(nearest / t - 1).max() < 0.05
-    assert table.grid[0] == pytest.approx(mat.t10_min) and table.grid[-1] == pytest.approx(mat.A)
+    assert table.grid[0] == pytest.approx(mat.t10_min) and table.grid[-1] == pytest.approx(mat.params.A)
 
 
 def test_drawn_family_has_exactly_the_parent_volume():

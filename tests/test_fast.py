@@ -151,7 +151,7 @@ def test_a_coarse_fixed_period_warns_and_says_how_wrong_t10_is(scene):
         r"its t10' is ([\d.]+) % .* gives ([\d.]+) %", text).groups())
     assert taken == pytest.approx(event["t10"], abs=0.005)
     cu = load_material("copper_ore")
-    assert at_crossing == pytest.approx(float(model.t10(1.0, cu.A, cu.b_prime, cu.kappa)),
+    assert at_crossing == pytest.approx(float(model.t10(1.0, cu.params.A, cu.params.b_prime, cu.params.kappa)),
                                         abs=0.005)
     every, _ = _unbreakable_impact("every_step")
     assert taken - every[0]["t10"] > 1.0       # a point and more of t10' wrong

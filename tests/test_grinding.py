@@ -18,13 +18,13 @@ from yadebreak.studies.grinding import (BatchGrinder, GrindingError, SpectraErro
 from yadebreak.model.capture import PACKING_MONOLAYER
 from yadebreak.studies.grinding.classes import FeedError
 from yadebreak.studies.grinding.cli import parse_feed
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 from yadebreak import model
 
 COPPER = load_material("copper_ore")
 #: copper ore so weak (E50 ~ 1e-9 J/kg) that every stressed particle breaks: the model reduces
 #: to the linear population balance with the capture model's rates
-BRITTLE = dataclasses.replace(COPPER, e_inf=1e-9)
+BRITTLE = COPPER.with_params(e_inf=1e-9)
 
 
 def single_size(d, count=4):
@@ -377,7 +377,7 @@ def test_mill_spectra_convert_so_the_model_gives_back_the_dem_rate(tmp_path):
         for j in range(12):
             w.writerow([edges[j], edges[j + 1]] + [v for k in rates for v in (
                 rates[k][j], rates[k][j:].sum())])
-    sp = read_spectra(write_spectra(tmp_path / "spectra.csv", from_mill_run(tmp_path)))
+    sp = read_spectra(write_spectra(tmp_path / "spectra.csv", from_mill_run(tmp_path, load_material)))
     assert sp.energy_basis == "absorbed" and sp.ore_mass_kg == ore_mass
     e = np.sqrt(edges[:-1] * edges[1:])
     particles = ore_mass / (COPPER.density * math.pi / 6 * d0 ** 3)

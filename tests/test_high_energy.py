@@ -25,11 +25,11 @@ def test_model_t10_follows_eq7_rises_with_energy_and_tends_to_a():
     cu, steel = load_material("copper_ore"), load_material("steel")
     energies = np.array([100.0, 300.0, 1000.0, 3000.0, 1e5])
     t10 = cu.t10_model(energies, 10e-3, steel)
-    assert np.all(np.diff(t10) > 0) and t10[-1] == pytest.approx(cu.A, rel=0.01)
+    assert np.all(np.diff(t10) > 0) and t10[-1] == pytest.approx(cu.params.A, rel=0.01)
     absorbed = cu.energy_partition(steel) * 1000.0
     e50b = model.median_fracture_energy_broken(absorbed, cu.median_fracture_energy(10e-3),
-                                               cu.sigma, cu.emax_ratio)
-    assert t10[2] == pytest.approx(cu.A * (1 - np.exp(-cu.b_prime * absorbed / e50b)), rel=1e-12)
+                                               cu.params.sigma, cu.params.emax_ratio)
+    assert t10[2] == pytest.approx(cu.params.A * (1 - np.exp(-cu.params.b_prime * absorbed / e50b)), rel=1e-12)
     # the larger particle (lower E50) breaks finer at the same energy (paper Fig. 16)
     assert cu.t10_model(1000.0, 29e-3, steel) > cu.t10_model(1000.0, 5.5e-3, steel)
 

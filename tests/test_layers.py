@@ -131,3 +131,91 @@ def test_no_class_over_300_lines_and_no_function_over_80():
     big = [f"{path.relative_to(PACKAGE)}: {node.name} has {n} lines" for path, node, n in _sizes()
            if n > (300 if isinstance(node, ast.ClassDef) else 80)]
     assert not big, "\n".join(big)
+
+
+def _private(name):
+    return name.startswith("_") and not name.startswith("__")
+
+
+def _names(target):
+    """The names an assignment's target binds (x, (x, y), *x)."""
+    if isinstance(target, ast.Name):
+        yield target.id
+    elif isinstance(target, (ast.Tuple, ast.List)):
+        for element in target.elts:
+            yield from _names(element)
+    elif isinstance(target, ast.Starred):
+        yield from _names(target.value)
+
+
+def _binds(node):
+    if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+        return {node.name}
+    targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(
+        node, (ast.AnnAssign, ast.AugAssign)) else []
+    return {name for target in targets for name in _names(target)}
+
+
+def _module_level(body):
+    """A module's own statements, also those inside its if, try and with blocks."""
+    for node in body:
+        yield node
+        if isinstance(node, (ast.If, ast.Try, ast.With)):
+            for block in (node.body, getattr(node, "orelse", []), getattr(node, "finalbody", []),
+                          *(h.body for h in getattr(node, "handlers", []))):
+                yield from _module_level(block)
+
+
+def _private_names(tree):
+    """The _-names a module defines: its functions, classes and assignments at module level, and
+    in its classes their methods, class attributes and self._x (cls._x) attributes."""
+    found = {name for node in _module_level(tree.body) for name in _binds(node)}
+    for cls in (n for n in ast.walk(tree) if isinstance(n, ast.ClassDef)):
+        found |= {name for node in cls.body for name in _binds(node)}
+        found |= {n.attr for n in ast.walk(cls) if isinstance(n, ast.Attribute)
+                  and isinstance(n.ctx, ast.Store) and isinstance(n.value, ast.Name)
+                  and n.value.id in ("self", "cls")}
+    return {name for name in found if _private(name)}
+
+
+def _module(path):
+    return ".".join(path.relative_to(PACKAGE.parent).with_suffix("").parts).removesuffix(".__init__")
+
+
+def _private_crossings(path, owners):
+    """Where a module imports another yadebreak module's _-name (a package's __init__ may, from
+    its own package) or reaches it as obj._x (self and cls are its own; a name this module also
+    defines, or no yadebreak module does, such as os._exit, is not another's)."""
+    tree = ast.parse(path.read_text())
+    module, where = _module(path), path.relative_to(PACKAGE.parent)
+    package = ".".join(where.parts[:-1])
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parts = package.split(".")
+                base = ".".join(parts[:len(parts) - node.level + 1] + ([base] if base else []))
+            own = path.name == "__init__.py" and (base + ".").startswith(package + ".")
+            if base.split(".")[0] == "yadebreak" and not own:
+                yield from (f"{where}:{node.lineno} {alias.name} (defined in {base})"
+                            for alias in node.names if _private(alias.name))
+        elif (isinstance(node, ast.Attribute) and _private(node.attr)
+              and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))):
+            others = owners.get(node.attr, set())
+            if others and module not in others:
+                yield f"{where}:{node.lineno} {node.attr} (defined in {', '.join(sorted(others))})"
+
+
+def test_no_private_name_crosses_modules():
+    """A _-name is the business of the module that defines it: no other module imports it or
+    calls it, so that module may change it without breaking another (a package's __init__ may
+    re-export its own modules' names)."""
+    paths = sorted(PACKAGE.rglob("*.py"))
+    owners = {}
+    for path in paths:
+        for name in _private_names(ast.parse(path.read_text())):
+            owners.setdefault(name, set()).add(_module(path))
+    wrong = [line for path in paths for line in _private_crossings(path, owners)]
+    assert not wrong, ("another module's _-name: give it a public spelling in the module that "
+                       "defines it, or move the code that needs it into that module:\n"
+                       + "\n".join(wrong))

@@ -8,7 +8,8 @@ import pytest
 
 import yadebreak
 from yadebreak import model
-from yadebreak.model.materials import MaterialError, available_materials, load_material
+from yadebreak.model.materials import MaterialError, available_materials
+from yadebreak.criteria import load_material
 
 GOOD = (yadebreak.model.materials.MATERIALS_DIR / "copper_ore.toml").read_text()
 
@@ -28,8 +29,8 @@ def test_every_shipped_material_loads():
 
 def test_units_converted_to_si_once():
     cu = load_material("copper_ore")
-    assert cu.young_modulus == 52e9 and cu.d0 == pytest.approx(8.07e-3)
-    assert cu.device_stiffness == 230e9 and cu.A == 67.7
+    assert cu.young_modulus == 52e9 and cu.params.d0 == pytest.approx(8.07e-3)
+    assert cu.params.device_stiffness == 230e9 and cu.params.A == 67.7
     assert cu.beta_params[1.2] == (0.51, 11.95) and cu.beta_source == "material"
     assert load_material("iron_ore_1").beta_params == model.TABLE1_BETA_PARAMS
     assert load_material("rubber").hertz_stiffness == pytest.approx(1.3e9, rel=1e-9)
@@ -38,7 +39,7 @@ def test_units_converted_to_si_once():
 def test_material_is_immutable():
     cu = load_material("copper_ore")
     with pytest.raises(dataclasses.FrozenInstanceError):
-        cu.sigma = 1.0
+        cu.params.sigma = 1.0
     with pytest.raises(TypeError):
         cu.beta_params[1.2] = (1, 1)
 
@@ -56,7 +57,7 @@ def test_contacts_table6_and_rubber_borrows_steel():
 def test_breakage_probability_uses_partner_share():
     cu, st = load_material("copper_ore"), load_material("steel")
     e50 = cu.median_fracture_energy(5.5e-3)
-    assert cu.breakage_probability(e50 * cu.emax_ratio / (cu.emax_ratio + 1) / 0.8062, 5.5e-3,
+    assert cu.breakage_probability(e50 * cu.params.emax_ratio / (cu.params.emax_ratio + 1) / 0.8062, 5.5e-3,
                                    partner=st) == pytest.approx(0.5, abs=1e-3)
 
 
@@ -173,7 +174,7 @@ def test_missing_empty_and_not_toml(tmp_path):
 def test_defaults_for_emax_ratio_and_kappa(tmp_path):
     text = GOOD.replace("emax_ratio = 100 ", "").replace("kappa = 1.0 ", "")
     mat = load_material(_write(tmp_path, text))
-    assert mat.emax_ratio == 100.0 and mat.kappa == 1.0
+    assert mat.params.emax_ratio == 100.0 and mat.params.kappa == 1.0
 
 
 def test_sampling_uses_the_generator(tmp_path):
@@ -187,13 +188,16 @@ def test_the_criterion_is_chosen_once_by_the_material_and_the_engine_uses_it():
     """The material's file names its criterion (Material.criterion, from the one registry); the
     engine's criterion_for gives that same object."""
     from yadebreak import criteria
-    from yadebreak.model.materials import CRITERIA
+    from yadebreak.criteria import CRITERIA
     assert CRITERIA == {"tavares": criteria.Tavares, "ab_t10": criteria.AbT10}
     for name in available_materials():
         mat = load_material(name)
-        assert mat.criterion.name == (mat.breakage_model or "tavares")
+        if not mat.breakable:
+            assert mat.params is None and mat.breakage_model is None
+            continue
+        assert mat.criterion.name == mat.breakage_model
         assert mat.is_ab_t10 == (mat.criterion.name == "ab_t10")
         if mat.breakable:
             assert criteria.criterion_for(mat) is mat.criterion
             assert type(mat.criterion) is criteria.criterion_class(mat.criterion.name)
-            assert mat.t10_ceiling == (mat.t10_max if mat.is_ab_t10 else mat.A)
+            assert mat.t10_ceiling == (mat.params.t10_max if mat.is_ab_t10 else mat.params.A)

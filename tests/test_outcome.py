@@ -15,7 +15,7 @@ import pytest
 
 from yadebreak import model
 from yadebreak.model import equations, families
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 from yadebreak.options.table import AttachError, Config
 
 PAPER_MATERIALS = ("copper_ore", "granulite", "limestone")
@@ -24,7 +24,7 @@ SIEVES = np.array([0.1, 0.15, 0.05, 1 / 25, 1 / 50, 1 / 75, 0.005])   # 1/10, an
 
 def _paper(name):
     """The material as the paper's single-particle runs take it (Emax/E50 = 4)."""
-    return dataclasses.replace(load_material(name), emax_ratio=4.0)
+    return load_material(name).with_params(emax_ratio=4.0)
 
 
 def _e50(mat, size):
@@ -67,11 +67,11 @@ def test_eq8s_mean_over_the_broken_is_that_of_drawn_particles():
     for name, energy in (("copper_ore", 300.0), ("granulite", 1000.0), ("limestone", 150.0)):
         mat = _paper(name)
         e50 = _e50(mat, 0.029)
-        drawn = model.sample_fracture_energy(rng, e50, mat.sigma, 4.0, size=200_000)
+        drawn = model.sample_fracture_energy(rng, e50, mat.params.sigma, 4.0, size=200_000)
         broken = drawn[drawn < energy]
-        t10 = model.t10(energy / broken, mat.A, mat.b_prime)
+        t10 = model.t10(energy / broken, mat.params.A, mat.params.b_prime)
         error = t10.std() / math.sqrt(len(t10))
-        mean = model.t10_mean_broken(energy, e50, mat.sigma, 4.0, mat.A, mat.b_prime)
+        mean = model.t10_mean_broken(energy, e50, mat.params.sigma, 4.0, mat.params.A, mat.params.b_prime)
         assert abs(mean - t10.mean()) < 4 * error, name
 
 
@@ -86,12 +86,12 @@ def test_the_batch_kappa_makes_eq8s_mean_eq7_within_the_papers_range():
         for energy in (150.0, 300.0, 1000.0, 3000.0):
             x = float(mat.absorbed(energy, steel))
             eq7 = float(mat.t10_model(energy, 0.029, steel))
-            kappa = model.kappa_of_batch(x, e50, mat.sigma, 4.0, mat.A, mat.b_prime)
-            assert model.t10_mean_broken(x, e50, mat.sigma, 4.0, mat.A, mat.b_prime,
+            kappa = model.kappa_of_batch(x, e50, mat.params.sigma, 4.0, mat.params.A, mat.params.b_prime)
+            assert model.t10_mean_broken(x, e50, mat.params.sigma, 4.0, mat.params.A, mat.params.b_prime,
                                          kappa) == pytest.approx(eq7, rel=1e-9)
-            if eq7 < 0.25 * mat.A:
-                assert 0.95 <= kappa <= math.exp(mat.sigma ** 2 / 2), (name, energy, kappa)
-                assert model.t10_mean_broken(x, e50, mat.sigma, 4.0, mat.A, mat.b_prime) > eq7
+            if eq7 < 0.25 * mat.params.A:
+                assert 0.95 <= kappa <= math.exp(mat.params.sigma ** 2 / 2), (name, energy, kappa)
+                assert model.t10_mean_broken(x, e50, mat.params.sigma, 4.0, mat.params.A, mat.params.b_prime) > eq7
     assert math.isnan(model.kappa_of_batch(0.0, 300.0, 0.8, 4.0, 60.0, 0.03))
 
 
@@ -141,10 +141,10 @@ def test_a_model_breakage_takes_eq8_at_the_events_peak_with_the_batch_kappa(scen
     tally, brk = _impacts("granulite", 300.0, 4, outcome="model", kappa="batch")
     assert len(tally.broken) == 4 and brk.config.fines == "eq10"
     for e in tally.broken:
-        kappa = model.kappa_of_batch(e["specific_energy"], _e50(gr, 2 * e["radius"]), gr.sigma,
-                                     4.0, gr.A, gr.b_prime)
+        kappa = model.kappa_of_batch(e["specific_energy"], _e50(gr, 2 * e["radius"]), gr.params.sigma,
+                                     4.0, gr.params.A, gr.params.b_prime)
         assert e["kappa"] == pytest.approx(kappa, rel=1e-9)
-        assert e["t10"] == pytest.approx(float(model.t10(e["ratio"], gr.A, gr.b_prime, kappa)),
+        assert e["t10"] == pytest.approx(float(model.t10(e["ratio"], gr.params.A, gr.params.b_prime, kappa)),
                                          rel=1e-9)
         assert e["specific_energy"] == pytest.approx(share, rel=0.03)
 
@@ -162,7 +162,7 @@ def test_single_impacts_give_the_models_t10_for_that_very_case(scene, kappa):
     gr, steel = _paper("granulite"), load_material("steel")
     x = float(gr.absorbed(300.0, steel))
     eq7 = float(gr.t10_model(300.0, 0.029, steel))
-    mean_eq8 = model.t10_mean_broken(x, _e50(gr, 0.029), gr.sigma, 4.0, gr.A, gr.b_prime)
+    mean_eq8 = model.t10_mean_broken(x, _e50(gr, 0.029), gr.params.sigma, 4.0, gr.params.A, gr.params.b_prime)
     expected, other = (eq7, mean_eq8) if kappa == "batch" else (mean_eq8, eq7)
     tally, _ = _impacts("granulite", 300.0, 128, outcome="model", kappa=kappa)
     result = reports.breakage_result_of(tally, gr, 300.0, steel)

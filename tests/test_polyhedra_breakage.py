@@ -260,6 +260,6 @@ def test_cube_on_a_plate_is_damaged_by_the_energy_it_absorbs(scene):
     (ev,) = [x for x in brk.events if x["kind"] == "damage"]
     assert ev["id"] == impact.particle
     assert ev["specific_energy"] == pytest.approx(e * speed ** 2 / 2.0, rel=1e-3)
-    expected = model.weakened_fracture_energy(50.0, ev["specific_energy"] / 50.0, mat.gamma)
+    expected = model.weakened_fracture_energy(50.0, ev["specific_energy"] / 50.0, mat.params.gamma)
     assert row.fracture_energy == pytest.approx(float(expected), rel=1e-12)
     assert row.damage == pytest.approx(1.0 - float(expected) / 50.0, rel=1e-12)

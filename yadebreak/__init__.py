@@ -24,9 +24,10 @@ from importlib import import_module
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 from yadebreak.model.materials import (Material, MaterialError, available_materials,
-                                       load_material, material_search_path)
+                                       material_search_path)
+from yadebreak.criteria import load_material
 from yadebreak import model
-from yadebreak import criteria  # registers the criteria in model.materials.CRITERIA
+from yadebreak import criteria
 from yadebreak._moved import install as _install_moved
 
 _install_moved()
@@ -37,7 +38,7 @@ __all__ = ["Material", "MaterialError", "available_materials", "load_material",
            "material_search_path", "model", "criteria", "attach", "save"]
 
 # where the modules of version 0.2 went: `from yadebreak import families` keeps working
-_MOVED = {"materials": "model.materials", "families": "model.families",
+_MOVED = {"materials": "criteria.registry", "families": "model.families",
           "placement": "model.placement", "bonds": "model.bonds", "milling": "model.milling",
           "intervals": "model.intervals", "reports": "analysis.reports",
           "scenes": "scenes", "poured_bed": "scenes.poured_bed",

@@ -19,7 +19,8 @@ import numpy as np
 from yadebreak.model import families
 from yadebreak.jobs.lifecycle import LOCK, save_figure, tool_run, write_atomic
 from yadebreak import model
-from yadebreak.model.materials import MaterialError, available_materials, load_material
+from yadebreak.model.materials import MaterialError, available_materials
+from yadebreak.criteria import load_material
 from yadebreak.options.flags import (DEBUG, ScriptParser, add_params, fail, integer,
                                      join_negative_values, number, out_option, overwrite_option,
                                      read_params, text)
@@ -49,7 +50,7 @@ def demo(args):
     axes[0].legend()
     ratio = np.linspace(1.0, 60.0, 300)
     axes[1].plot(ratio, mat.t10(ratio))
-    axes[1].axhline(mat.A, ls=":", c="k", label=f"A = {mat.A:g} %")
+    axes[1].axhline(mat.params.A, ls=":", c="k", label=f"A = {mat.params.A:g} %")
     axes[1].set(xlabel="Ek' / (mp E)", ylabel="t10' (%)", title="Eq. 8")
     axes[1].legend()
     x = np.geomspace(1e-3, 1.0, 300)
@@ -67,7 +68,7 @@ def demo(args):
                "t10_min_percent": mat.t10_min, "plot": str(path)}
     write_atomic(out / "summary.json", json.dumps(summary, indent=2))
     print(f"{mat.name}: E50(5.5 mm) = {e50:.1f} J/kg, e on steel = "
-          f"{mat.energy_partition(steel):.3f}, t10' from {mat.t10_min:.2f} % to A = {mat.A:g} %")
+          f"{mat.energy_partition(steel):.3f}, t10' from {mat.t10_min:.2f} % to A = {mat.params.A:g} %")
     print(f"wrote {path}")
 
 

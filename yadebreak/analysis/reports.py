@@ -124,8 +124,9 @@ class ImpactTally:
         broken = {i for i, e in first.items() if e["kind"] == "breakage"}
         self.particles += len(ids)
         self.first += list(first.values())
-        self.e_cum_intact += [brk.bodies[i].e_cum for i in ids
-                              if i not in broken and i in brk.bodies]
+        if "e_cum" in brk.bodies.columns:            # a column of Ab-T10's (intact_measures)
+            self.e_cum_intact += [brk.bodies[i].e_cum for i in ids
+                                  if i not in broken and i in brk.bodies]
         if broken:
             passing = brk.size_distribution(self.size * RELATIVE_SIEVES).passing_mass
             self.progeny_mass += passing

@@ -4,33 +4,51 @@ energy); a breakage's t10 is Eq. 9.4 at e_cum."""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from yadebreak import model
-from yadebreak.criteria.base import Criterion, register
+from yadebreak.criteria.base import Criterion
 from yadebreak.model.intervals import PARTICLE_SIZE
 from yadebreak.model.kinds import BREAKABLE
-from yadebreak.model.materials import GLOBAL_DAMPING_KEY, in_file_unit
+from yadebreak.model.materials import Key
 
 #: Ab-T10 events with t10 below this (%) take the family set at this t10 (see t10_min): below it
 #: the 11 classes cannot follow Eq. 10 within 2 % (2.6 % at t10 = 1 %).
 AB_T10_T10_FLOOR = 2.0
 
 
-@register
+@dataclass(frozen=True)
+class AbT10Params:
+    """The Ab-T10 parameters of a material (docs/model.md Section 9), SI."""
+
+    e_min_ref: float     # J/kg, Eq. 9.1 at size_ref
+    size_ref: float      # m
+    selection: float     # S, kg/J, Eq. 9.3
+    t10_max: float       # M, %, Eq. 9.4
+
+    def criterion(self, material):
+        """The criterion of a material with these parameters."""
+        return AbT10(material)
+
+
 class AbT10(Criterion):
     """Rocky's Ab-T10 criterion of one material."""
 
     name = "ab_t10"
     keys = (
-        ("e_min_ref", 0.0, True, math.inf, False, "J/kg", 1.0),
-        ("size_ref", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
-        ("selection", 0.0, False, math.inf, False, "kg/J", 1.0),
-        ("t10_max", 0.0, False, 100.0, True, "%", 1.0),
-        GLOBAL_DAMPING_KEY,
+        Key("e_min_ref", 0.0, True, math.inf, False, "J/kg"),
+        Key.of("size_ref", PARTICLE_SIZE, "mm", 1e-3),
+        Key("selection", 0.0, False, math.inf, False, "kg/J"),
+        Key("t10_max", 0.0, False, 100.0, True, "%"),
     )
-    defaults = {"global_damping": 0.0}
+    Params = AbT10Params
+    calibrated = ("e_min_ref", "size_ref", "selection", "t10_max")
+    #: Eq. 9.2's state of each body (J/kg): e_min at its size (Eq. 9.1), e_cum, the event's
+    #: largest e_t so far and e_t at the previous read
+    columns = {"e_min": (np.float64, 0.0), "e_cum": (np.float64, 0.0),
+               "e_max": (np.float64, 0.0), "e_prev": (np.float64, 0.0)}
     probability_label = "model P(e_cum), e_cum = e Ek/mp - e_min (Eqs. 4, 9.1-9.3)"
     t10_label = "model: Eq. 9.4"
     repeated_label = "model P(e_cum), e_cum = k (e Ek/mp - e_min) (Eqs. 9.1-9.3)"
@@ -46,19 +64,19 @@ class AbT10(Criterion):
     # -- model side -----------------------------------------------------------------------------
     def min_energy(self, size):
         """Eq. 9.1: e_min (J/kg) at size `size` (m)."""
-        m = self.material
-        return model.ab_t10_min_energy(size, m.e_min_ref, m.size_ref)
+        p = self.params
+        return model.ab_t10_min_energy(size, p.e_min_ref, p.size_ref)
 
     def _cdf(self, energy, size):
         """Eq. 9.3: P(e_cum threshold < `energy`)."""
-        m = self.material
-        return model.ab_t10_probability(energy, size, self.min_energy(size), m.selection,
-                                        m.size_ref)
+        p = self.params
+        return model.ab_t10_probability(energy, size, self.min_energy(size), p.selection,
+                                        p.size_ref)
 
     def _ppf(self, u, size):
         """Eq. 9.3 inverted: the e_cum threshold of strength u."""
-        m = self.material
-        return model.ab_t10_threshold(u, size, self.min_energy(size), m.selection, m.size_ref)
+        p = self.params
+        return model.ab_t10_threshold(u, size, self.min_energy(size), p.selection, p.size_ref)
 
     def _rvs(self, rng, size):
         """The e_cum threshold of a strength drawn uniform in [0, 1)."""
@@ -74,9 +92,9 @@ class AbT10(Criterion):
 
     def t10_of_cumulative_energy(self, e_cum, size):
         """Eq. 9.4: t10 (%) of a particle of size `size` (m) broken at e_cum (J/kg)."""
-        m = self.material
-        return model.ab_t10_t10(e_cum, size, self.min_energy(size), m.selection, m.size_ref,
-                                m.t10_max)
+        p = self.params
+        return model.ab_t10_t10(e_cum, size, self.min_energy(size), p.selection, p.size_ref,
+                                p.t10_max)
 
     def t10_once(self, absorbed, size):
         """The mean of Eq. 9.4 (%) over the particles that break after one loading absorbing
@@ -88,12 +106,12 @@ class AbT10(Criterion):
     @property
     def t10_min(self):
         """No floor in Eq. 9.4: AB_T10_T10_FLOOR (%), or M / 2 when smaller."""
-        return min(AB_T10_T10_FLOOR, 0.5 * self.material.t10_max)
+        return min(AB_T10_T10_FLOOR, 0.5 * self.params.t10_max)
 
     @property
     def t10_ceiling(self):
         """M (%), Eq. 9.4's largest t10."""
-        return self.material.t10_max
+        return self.params.t10_max
 
     def intact_measures(self, e_cum_intact, size):
         """The mean e_cum (J/kg) the intact particles of an impact test carry (what the broken
@@ -106,9 +124,9 @@ class AbT10(Criterion):
     def repeated_broken_fraction(self, absorbed, size, impacts):
         """Eqs. 9.1-9.3: the fraction broken after each of `impacts` loadings, each absorbing
         `absorbed` (J/kg), e_cum adding up over the impacts."""
-        m = self.material
+        p = self.params
         return model.ab_t10_repeated_broken_fraction(absorbed, size, float(self.min_energy(size)),
-                                                     m.selection, m.size_ref, impacts)
+                                                     p.selection, p.size_ref, impacts)
 
     # -- engine side ----------------------------------------------------------------------------
     def sample(self, rng, sizes):

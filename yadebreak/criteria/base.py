@@ -2,12 +2,13 @@
 distribution and t10) and for the engine (judge, unload, breakage), and the one registry of the
 criteria a material file may name (`breakage.model`).
 
-Public methods check and convert their input, then call the criterion's hooks (scipy.stats'
-shape): a criterion writes `_cdf`, `_ppf` and `_rvs`, and the engine-side methods below. The
-registry is model.materials.CRITERIA (the model reads it to parse a file and to build
-Material.criterion, and may not import this room); `register` is its one writer. Adding a
-criterion is one file of this folder: a subclass decorated with @register, imported by
-criteria/__init__.py.
+A criterion owns what is its own: its [breakage] keys with their ranges and units (`keys`), the
+frozen dataclass of its parameters (`Params`, one field per key, SI; a Material holds one as
+`params`), the per-body columns it keeps in the engine's body table (`columns`), and its model
+and engine sides. Public methods check and convert their input, then call the criterion's hooks
+(scipy.stats' shape): a criterion writes `_cdf`, `_ppf` and `_rvs`, and the engine-side methods
+below. The registry is registry.CRITERIA, one line per criterion (docs/architecture.md, "A new
+criterion").
 
 Model side, energies in J/kg and sizes in m, numpy arrays of any shape:
     cdf(energy, size), ppf(u, size), rvs(rng, size)    the fracture-energy distribution
@@ -28,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from yadebreak.criteria.judgement import Judgement
-from yadebreak.model.materials import CRITERIA
+from yadebreak.model.equations import DEVICE_STIFFNESS_STEEL
 
 
 class Criterion:
@@ -36,10 +37,17 @@ class Criterion:
 
     #: the file's breakage.model naming this criterion (None: not named by files)
     name = None
-    #: [breakage] keys of a material file, as (key, lower, lower inclusive, upper, upper
-    #: inclusive, unit in file, SI factor), the defaults of the optional ones, and the keys
-    #: beyond these that parse_more reads
-    keys, defaults, more_keys = (), {}, frozenset()
+    #: its [breakage] keys (model.materials.Key: range and unit in the file, factor to SI,
+    #: default), besides those every criterion shares (model.materials.SHARED_BREAKAGE_KEYS)
+    keys = ()
+    #: its parameters: a frozen dataclass with one field per key (SI) and criterion(material)
+    Params = None
+    #: the per-body columns it keeps in the engine's body table, beyond the shared ones
+    #: (engine/state.py): name -> (numpy dtype, value of a new row)
+    columns = {}
+    #: the keys `python3 -m yadebreak fit` estimates from laboratory data or else takes from a
+    #: base material (the others come from the base or their default)
+    calibrated = ()
     #: the plots' legends of the model's breakage probability, t10 and repeated impacts
     probability_label = t10_label = repeated_label = ""
     #: bodies of a lower order are settled first in a read (Controller._settle)
@@ -53,10 +61,31 @@ class Criterion:
 
     def __init__(self, material):
         self.material = material
+        self.params = material.params
 
-    @staticmethod
-    def parse_more(breakage, values, problems):
-        """The keys more_keys of [breakage] into `values` (SI): none here."""
+    # -- the material file --------------------------------------------------------------------
+    @classmethod
+    def file_keys(cls):
+        """The names of its [breakage] keys."""
+        return frozenset(k.name for k in cls.keys)
+
+    @classmethod
+    def parse(cls, table, where, problems):
+        """Its Params from a file's [breakage] `table` (checked, in SI), or None with every
+        problem appended to `problems` (`where` names the table in them)."""
+        values = {k.name: k.read(table, where, problems) for k in cls.keys}
+        return None if None in values.values() else cls.Params(**values)
+
+    @classmethod
+    def key(cls, name):
+        """Its Key named `name`."""
+        return next(k for k in cls.keys if k.name == name)
+
+    @classmethod
+    def in_file_unit(cls, params):
+        """{key: value in the file's unit} of `params`, in the order of `keys` (what a fitted
+        material file writes)."""
+        return {k.name: getattr(params, k.name) / k.factor for k in cls.keys}
 
     def with_settings(self, kappa_successive=None, t10_energy="particle", batch_kappa=False):
         """This criterion with Eq. 8's kappa of fragments, the energy of a breakage's t10' and
@@ -81,6 +110,12 @@ class Criterion:
         """The fracture energy (J/kg) half the particles of size `size` (m) stay below."""
         return self.ppf(0.5, size)
 
+    @property
+    def device_stiffness(self):
+        """The stiffness (Pa) of the device the fracture energies are measured with (Eq. 3's
+        correction): steel's, unless the criterion's parameters name another."""
+        return DEVICE_STIFFNESS_STEEL
+
     # -- engine side --------------------------------------------------------------------------
     def overridden(self, kappa=None, emax_ratio=None):
         """The material with attach()'s overrides applied (criteria without them: unchanged)."""
@@ -100,17 +135,12 @@ class Criterion:
         raise NotImplementedError
 
 
-def register(cls):
-    """Class decorator: `cls` becomes the criterion of materials whose file names cls.name."""
-    if cls.name in CRITERIA:
-        raise ValueError(f"criterion name {cls.name!r} registered twice "
-                         f"({CRITERIA[cls.name].__name__} and {cls.__name__})")
-    CRITERIA[cls.name] = cls
-    return cls
-
-
-def criterion_class(name):
-    """The registered criterion class named `name` (a file's breakage.model)."""
-    if name not in CRITERIA:
-        raise ValueError(f"criterion = {name!r}: accepted {', '.join(map(repr, CRITERIA))}")
-    return CRITERIA[name]
+def registry(*classes):
+    """{name: class} of criterion classes, refusing a name given twice."""
+    found = {}
+    for cls in classes:
+        if cls.name in found:
+            raise ValueError(f"criterion name {cls.name!r} registered twice "
+                             f"({found[cls.name].__name__} and {cls.__name__})")
+        found[cls.name] = cls
+    return found

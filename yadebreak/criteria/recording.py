@@ -23,6 +23,7 @@ class Recording(Criterion):
         super().__init__(inner.material)
         self.inner = inner
         self.order = inner.order
+        self.columns = inner.columns
         self.probability_label = inner.probability_label
         self.t10_label = inner.t10_label
         self.repeated_label = inner.repeated_label

@@ -3,17 +3,36 @@ it absorbs, Ek'/m, passes its fracture energy E, drawn from an upper-truncated l
 1-3); an event that ends without breakage weakens it (Eqs. 5-6); a breakage's t10' is Eq. 8."""
 from __future__ import annotations
 
-import dataclasses
 import math
+from dataclasses import dataclass
 
 from yadebreak import model
-from yadebreak.criteria.base import Criterion, register
+from yadebreak.criteria.base import Criterion
 from yadebreak.model.intervals import PARTICLE_SIZE, YOUNG_MODULUS
 from yadebreak.model.kinds import BREAKABLE
-from yadebreak.model.materials import GLOBAL_DAMPING_KEY, in_file_unit, read_number
+from yadebreak.model.materials import Key
 
 
-@register
+@dataclass(frozen=True)
+class TavaresParams:
+    """The Tavares parameters of a material (docs/model.md Table 2), SI."""
+
+    e_inf: float              # J/kg, Eq. 3
+    d0: float                 # m, Eq. 3
+    phi: float                # Eq. 3
+    sigma: float              # Eq. 1
+    emax_ratio: float         # Emax / E50, Eq. 2
+    gamma: float              # Eq. 6
+    A: float                  # %, Eq. 8
+    b_prime: float            # Eq. 8
+    kappa: float              # Eq. 8
+    device_stiffness: float   # Pa, Eq. 3: the device the fracture energies were measured with
+
+    def criterion(self, material):
+        """The criterion of a material with these parameters."""
+        return Tavares(material)
+
+
 class Tavares(Criterion):
     """The Tavares UFRJ criterion of one material. kappa_successive: Eq. 8's kappa for fragments
     (generation >= 1); None: the material's for every event. t10_energy: the fracture energy in a
@@ -21,19 +40,20 @@ class Tavares(Criterion):
 
     name = "tavares"
     keys = (
-        ("e_inf", 0.0, False, math.inf, False, "J/kg", 1.0),
-        ("d0", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
-        ("phi", 0.0, True, 10.0, True, "-", 1.0),
-        ("sigma", 0.0, False, 10.0, True, "-", 1.0),
-        ("emax_ratio", 1.0, False, math.inf, False, "-", 1.0),
-        ("gamma", 0.0, False, 1000.0, True, "-", 1.0),
-        ("A", 0.0, False, 100.0, True, "%", 1.0),
-        ("b_prime", 0.0, False, math.inf, False, "-", 1.0),
-        ("kappa", 0.0, False, math.inf, False, "-", 1.0),
-        GLOBAL_DAMPING_KEY,
+        Key("e_inf", 0.0, False, math.inf, False, "J/kg"),
+        Key.of("d0", PARTICLE_SIZE, "mm", 1e-3),
+        Key("phi", 0.0, True, 10.0, True, "-"),
+        Key("sigma", 0.0, False, 10.0, True, "-"),
+        Key("emax_ratio", 1.0, False, math.inf, False, "-", default=100.0),
+        Key("gamma", 0.0, False, 1000.0, True, "-"),
+        Key("A", 0.0, False, 100.0, True, "%"),
+        Key("b_prime", 0.0, False, math.inf, False, "-"),
+        Key("kappa", 0.0, False, math.inf, False, "-", default=1.0),
+        Key.of("device_stiffness", YOUNG_MODULUS, "GPa", 1e9,
+               default=model.DEVICE_STIFFNESS_STEEL / 1e9),
     )
-    defaults = {"emax_ratio": 100.0, "kappa": 1.0, "global_damping": 0.0}
-    more_keys = frozenset({"device_stiffness"})
+    Params = TavaresParams
+    calibrated = ("e_inf", "d0", "phi", "sigma", "emax_ratio", "gamma", "A", "b_prime")
     probability_label = "model (Eqs. 1-4)"
     t10_label = "model: Eq. 7, e Ek/mp over E50b of the broken particles"
     repeated_label = "model (Eqs. 1-6), gamma = {gamma:g}"
@@ -51,38 +71,35 @@ class Tavares(Criterion):
         self.t10_energy = t10_energy
         self.batch_kappa = batch_kappa
 
-    @staticmethod
-    def parse_more(breakage, values, problems):
-        """[breakage] device_stiffness (GPa in the file, Pa in `values`)."""
-        dev = read_number(breakage, "device_stiffness", "breakage", problems,
-                          *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", required=False,
-                          default=model.DEVICE_STIFFNESS_STEEL / 1e9)
-        values["device_stiffness"] = None if dev is None else dev * 1e9
-
     def with_settings(self, kappa_successive=None, t10_energy="particle", batch_kappa=False):
         return Tavares(self.material, kappa_successive, t10_energy, batch_kappa)
 
     # -- model side -----------------------------------------------------------------------------
     def median_fracture_energy(self, size):
         """Eq. 3: E50 (J/kg) at size `size` (m), against the material's device stiffness."""
-        m = self.material
-        return model.median_fracture_energy(size, m.e_inf, m.d0, m.phi, m.hertz_stiffness,
-                                            m.device_stiffness)
+        p = self.params
+        return model.median_fracture_energy(size, p.e_inf, p.d0, p.phi,
+                                            self.material.hertz_stiffness, p.device_stiffness)
+
+    @property
+    def device_stiffness(self):
+        """The device of the file's fracture energies (Pa; steel's by default)."""
+        return self.params.device_stiffness
 
     def _cdf(self, energy, size):
-        m = self.material
-        return model.fracture_energy_cdf(energy, self.median_fracture_energy(size), m.sigma,
-                                         m.emax_ratio)
+        p = self.params
+        return model.fracture_energy_cdf(energy, self.median_fracture_energy(size), p.sigma,
+                                         p.emax_ratio)
 
     def _ppf(self, u, size):
-        m = self.material
-        return model.fracture_energy_ppf(u, self.median_fracture_energy(size), m.sigma,
-                                         m.emax_ratio)
+        p = self.params
+        return model.fracture_energy_ppf(u, self.median_fracture_energy(size), p.sigma,
+                                         p.emax_ratio)
 
     def _rvs(self, rng, size):
-        m = self.material
-        return model.sample_fracture_energy(rng, self.median_fracture_energy(size), m.sigma,
-                                            m.emax_ratio, size=size.shape)
+        p = self.params
+        return model.sample_fracture_energy(rng, self.median_fracture_energy(size), p.sigma,
+                                            p.emax_ratio, size=size.shape)
 
     def probability_once(self, absorbed, size):
         """P that a fresh particle of size `size` (m) breaks when it absorbs `absorbed` (J/kg)."""
@@ -90,36 +107,36 @@ class Tavares(Criterion):
 
     def t10(self, ratio, kappa=None):
         """Eq. 8 (%); ratio = Ek' / (mp E); kappa None: the material's."""
-        m = self.material
-        return model.t10(ratio, m.A, m.b_prime, m.kappa if kappa is None else kappa)
+        p = self.params
+        return model.t10(ratio, p.A, p.b_prime, p.kappa if kappa is None else kappa)
 
     def t10_once(self, absorbed, size):
         """Eq. 7 (%) at `absorbed` (J/kg) over E50b of the particles of size `size` (m) that
         break at it."""
-        m = self.material
+        p = self.params
         e50b = model.median_fracture_energy_broken(absorbed, self.median_fracture_energy(size),
-                                                   m.sigma, m.emax_ratio)
-        return model.t10_batch(absorbed, e50b, m.A, m.b_prime)
+                                                   p.sigma, p.emax_ratio)
+        return model.t10_batch(absorbed, e50b, p.A, p.b_prime)
 
     @property
     def t10_min(self):
         """Eq. 9 (%); with batch_kappa at kappa = exp(sigma^2 / 2), the paper's largest (the
         family table's floor)."""
-        m = self.material
-        kappa = math.exp(m.sigma ** 2 / 2.0) if self.batch_kappa else m.kappa
-        return float(model.t10_primary(m.A, m.b_prime, kappa))
+        p = self.params
+        kappa = math.exp(p.sigma ** 2 / 2.0) if self.batch_kappa else p.kappa
+        return float(model.t10_primary(p.A, p.b_prime, kappa))
 
     def kappa_of_batch(self, absorbed, size):
         """The kappa at which Eq. 8's mean over the particles of size `size` (m) that break at
         `absorbed` (J/kg) is Eq. 7 (model.kappa_of_batch)."""
-        m = self.material
-        return model.kappa_of_batch(absorbed, float(self.median_fracture_energy(size)), m.sigma,
-                                    m.emax_ratio, m.A, m.b_prime)
+        p = self.params
+        return model.kappa_of_batch(absorbed, float(self.median_fracture_energy(size)), p.sigma,
+                                    p.emax_ratio, p.A, p.b_prime)
 
     @property
     def t10_ceiling(self):
         """A (%), Eq. 8's largest t10'."""
-        return self.material.A
+        return self.params.A
 
     def intact_measures(self, e_cum_intact, size):
         """What the intact particles of an impact test carry for its result: nothing here."""
@@ -128,16 +145,16 @@ class Tavares(Criterion):
     def repeated_broken_fraction(self, absorbed, size, impacts):
         """Eqs. 1-6: the fraction of particles of size `size` (m) broken after each of
         `impacts` loadings, each absorbing `absorbed` (J/kg), damage weakening the survivors."""
-        m = self.material
+        p = self.params
         e50 = float(self.median_fracture_energy(size))
-        return model.repeated_impact_broken_fraction(absorbed, e50, m.sigma, m.emax_ratio,
-                                                     m.gamma, impacts)
+        return model.repeated_impact_broken_fraction(absorbed, e50, p.sigma, p.emax_ratio,
+                                                     p.gamma, impacts)
 
     # -- engine side ----------------------------------------------------------------------------
     def overridden(self, kappa=None, emax_ratio=None):
         """The material with attach()'s overrides of kappa (Eq. 8) and Emax/E50 (Eq. 2)."""
         changes = {k: v for k, v in (("kappa", kappa), ("emax_ratio", emax_ratio)) if v is not None}
-        return dataclasses.replace(self.material, **changes) if changes else self.material
+        return self.material.with_params(**changes) if changes else self.material
 
     @staticmethod
     def judge_one(c, i, ek, specific):
@@ -160,7 +177,7 @@ class Tavares(Criterion):
         ratio = float(c["event_max"][i]) / (float(c["mass"][i]) * before)
         if c["kind"][i] != BREAKABLE:
             return None
-        after = float(model.weakened_fracture_energy(before, ratio, self.material.gamma))
+        after = float(model.weakened_fracture_energy(before, ratio, self.params.gamma))
         c["fracture_energy"][i] = after
         c["damage"][i] = 1.0 - after / float(c["fracture_energy_initial"][i])
         return {"fracture_energy": before, "fracture_energy_after": after, "ratio": ratio}

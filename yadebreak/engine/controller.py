@@ -20,7 +20,7 @@ from yadebreak.engine.safeguards import LargeOverlaps
 from yadebreak.criteria import criterion_for
 from yadebreak.engine.judging import Judge, Rules
 from yadebreak.engine.replacement import Recipe, Replacer
-from yadebreak.engine.state import BREAKABLE, BROKEN, UNBREAKABLE, EngineState
+from yadebreak.engine.state import BREAKABLE, BROKEN, UNBREAKABLE, EngineState, assembled_columns
 from yadebreak.engine.stepping import FragmentDamping, ReadSchedule, TimeStep
 from yadebreak.engine.tracking import Tracking
 from yadebreak.engine.zeroing import OverlapZeroing
@@ -56,9 +56,10 @@ class YadebreakWarning(RuntimeWarning):
 
 class Controller:
     """The engine of one scene: its state, its parts, and the results (`events`,
-    `size_distribution`, `body_state`)."""
+    `size_distribution`, `body_state`). `saved`: the state of a stored scene (EngineState's
+    to_dict), None for a new one."""
 
-    def __init__(self, label, config, scene_materials, material_names, state=None):
+    def __init__(self, label, config, scene_materials, material_names, saved=None):
         self.label = label
         self.config = config
         self.material_names = dict(material_names)      # as given to attach (saved)
@@ -69,8 +70,9 @@ class Controller:
                                             config.criteria.t10_energy,
                                             config.criteria.kappa == "batch")
                          for lab, mat in self.material.items()}
-        labels = list(self.material)
-        self.state = state or EngineState(labels, config.seed, config.output.event_log)
+        columns, log = assembled_columns(self.criteria.values()), config.output.event_log
+        self.state = (EngineState(list(self.material), config.seed, log, columns) if saved is None
+                      else EngineState.from_dict(saved, log, columns))
         # criterion of each material index of the body table
         self._criterion_of = [self.criteria[lab] for lab in self.state.table.labels]
         self.pause_steps = {lab: (config.criteria.pause_steps if config.criteria.pause_steps
@@ -86,7 +88,7 @@ class Controller:
         self.schedule = ReadSchedule(config.reading, label, self.tracking.smallest_breakable,
                                      self.tracking.reach_now if fast else None,
                                      every_step=volumetric)
-        self.time_step = TimeStep(config.time_step.time_step_fraction, self._warn_once)
+        self.time_step = TimeStep(config.time_step.time_step_fraction, self.warn_once)
         gd = config.time_step.global_damping        # None: each material file's
         self.damping = FragmentDamping(
             {lab: (gd if gd is not None else mat.global_damping)
@@ -203,7 +205,7 @@ class Controller:
         self.tracking.adopt(ids.tolist())
         self.state.top_size = max(self.state.top_size, float(sizes.max()))
 
-    def _warn_once(self, cause, message, remedies=(), purpose=""):
+    def warn_once(self, cause, message, remedies=(), purpose=""):
         """A YadebreakWarning, once per cause for this controller (scripts: once per run)."""
         if cause not in self.state.warned:
             self.state.warned.add(cause)
@@ -244,7 +246,7 @@ class Controller:
         crit = self.criteria[table.label_of(bid)]
         ratio, t10, _ = crit.breakage(table, bid, ek)
         low = crit.t10_at_threshold(table, bid, scale)
-        self._warn_once("jump", (
+        self.warn_once("jump", (
             f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
             f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s): "
             f"its t10' is {t10:.2f} % (at {ratio:.2f} times its fracture energy) where a read at "

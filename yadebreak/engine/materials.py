@@ -9,7 +9,8 @@ from collections.abc import Mapping
 from yadebreak import model
 from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS, Interval
 from yadebreak.model.cells import sieve_size
-from yadebreak.model.materials import Material, MaterialError, load_material
+from yadebreak.model.materials import Material, MaterialError
+from yadebreak.criteria import load_material
 from yadebreak.adapter.yade_api import O, extend_match_makers, wrapper
 from yadebreak.options.table import AttachError
 from yadebreak.criteria import criterion_for
@@ -41,7 +42,9 @@ def check_physical(mat, what, fields=_PHYSICAL):
                               f"{interval}{shown}")
 
 
-def _as_material(name):
+def as_material(name):
+    """`name` if it is a Material, else the material it names (a name or a .toml path), loaded
+    here, at attach's edge; a file that does not load is an AttachError (one message)."""
     try:
         return name if isinstance(name, Material) else load_material(name)
     except MaterialError as exc:
@@ -59,7 +62,7 @@ def add_materials(labels, stiffness_scale=1.0, kinds=None):
     """
     mats, ids = {}, {}
     for label, name in labels.items():
-        mats[label] = _as_material(name)
+        mats[label] = as_material(name)
         frict = _frict_material(mats[label], label, stiffness_scale,
                                 (kinds or {}).get(label, "FrictMat"))
         check_physical(frict, f"material '{label}' ({mats[label].source}) with stiffness_scale = "
@@ -89,7 +92,7 @@ def rolling_friction(labels, overrides=None):
     add_materials(labels). Returns ({(YADE material id, id): mu_r}, {"la-lb": mu_r} for reports)."""
     overrides = {tuple(sorted(k)): float(v) for k, v in (overrides or {}).items()}
     ids = {m.label: m.id for m in O.materials}
-    mats = {label: _as_material(name) for label, name in labels.items()}
+    mats = {label: as_material(name) for label, name in labels.items()}
     by_ids, named = {}, {}
     for la in labels:
         for lb in labels:
@@ -181,7 +184,7 @@ def check_mapping(materials):
             f"material a label (FrictMat(..., label='ore')) and map it in attach(materials=...)")
     found = {}
     for lab, name in materials.items():
-        mat = _as_material(name)
+        mat = as_material(name)
         if not mat.breakable:
             raise AttachError(f"material '{mat.name}' (label '{lab}') is not breakable: map only "
                               "breakable materials in attach(materials=...)")

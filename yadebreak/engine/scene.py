@@ -15,7 +15,7 @@ from yadebreak.adapter.yade_api import O, find_engine, scene_folder, wrapper
 from yadebreak.options.table import AttachError, Config
 from yadebreak.engine.controller import Controller
 from yadebreak.engine.materials import breakable_spheres, check_mapping, dummy_materials, resolve
-from yadebreak.engine.state import EngineState, EventLog
+from yadebreak.engine.state import EventLog
 from yadebreak.engine.stepping import smallest_rayleigh_time
 
 _TAG = "yadebreak:"
@@ -117,15 +117,15 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     ctl = Controller(label, config, scene_materials, materials)
     ctl.register(spheres)
     if not len(ctl.bodies):
-        ctl._warn_once("empty", "the scene has no breakable body: nothing will break (materials "
-                       f"mapped: {sorted(materials)})")
+        ctl.warn_once("empty", "the scene has no breakable body: nothing will break (materials "
+                      f"mapped: {sorted(materials)})")
     ctl.state.log.start()
     ctl.damping.apply_at_attach()
     user_dt = None if O.dt == YADE_DEFAULT_DT else O.dt
     if law == "volumetric" and user_dt is None:
-        ctl._warn_once("dt", f"O.dt is YADE's default {O.dt:g} s: the engine sets no time step "
-                       "for polyhedra on the volumetric law; set O.dt before attach (the "
-                       "scenes use 1 % of a particle's Rayleigh time: docs/polyhedra.md)")
+        ctl.warn_once("dt", f"O.dt is YADE's default {O.dt:g} s: the engine sets no time step "
+                      "for polyhedra on the volumetric law; set O.dt before attach (the "
+                      "scenes use 1 % of a particle's Rayleigh time: docs/polyhedra.md)")
     ctl.time_step.at_attach(smallest_rayleigh_time(), user_dt)
     ctl.last_iter = O.iter - 1
     protocol.install(BreakageEngine(label, ctl), engines)
@@ -258,8 +258,7 @@ def _restore(label, data, period):
     config = Config.from_options(**{**data["options"], "event_log": _stored_event_log(data)})
     scene_materials = resolve(check_mapping(data["materials"]), config.criteria.kappa,
                               config.criteria.emax_ratio, contact_law(list(O.engines))[1])
-    state = EngineState.from_dict(data["state"], config.output.event_log)
-    ctl = Controller(label, config, scene_materials, data["materials"], state)
+    ctl = Controller(label, config, scene_materials, data["materials"], data["state"])
     own = find_engine(label)                  # a PyRunner of its own (older scenes)
     ctl.schedule.period = own.iterPeriod if own is not None else period
     ctl.schedule.restore(data["fast"])
@@ -267,7 +266,7 @@ def _restore(label, data, period):
     ctl.zeroing.restore(data["zeroed"])
     ctl.damping.until = [tuple(x) for x in data["damped_until"]]
     ctl.last_iter = data.get("last_read", data["iter"] - 1)   # the steps since it: the next read's
-    state.log.rewrite()                    # the log holds exactly the events of this state
+    ctl.state.log.rewrite()                # the log holds exactly the events of this state
     return ctl
 
 

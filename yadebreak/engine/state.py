@@ -28,8 +28,9 @@ class Breakable(NamedTuple):
     radius: float         # m: a sphere's; half a polyhedron's sieve size
 
 
-#: column -> (dtype, value of a new row); energies J/kg, event_max J, sizes m, mass kg
-_COLUMNS = {
+#: the columns of every body table: column -> (dtype, value of a new row); energies J/kg,
+#: event_max J, sizes m, mass kg. A criterion adds its own (Criterion.columns).
+SHARED_COLUMNS = {
     "kind": (np.int8, NONE),
     "material": (np.int16, -1),            # index into BodyTable.labels
     "mass": (np.float64, 0.0),
@@ -46,31 +47,41 @@ _COLUMNS = {
     "parent_size": (np.float64, math.nan),               # dummy: the parent's diameter
     "generation": (np.int32, 0),
     "pause_until": (np.int64, -1),      # no energy counted before this iteration (fresh fragments)
-    "e_min": (np.float64, 0.0),         # Ab-T10, Eq. 9.1 at the body's size
-    "e_cum": (np.float64, 0.0),         # Ab-T10, Eq. 9.2
-    "e_max": (np.float64, 0.0),
-    "e_prev": (np.float64, 0.0),        # Ab-T10: e_t at the previous read
 }
+
+
+def assembled_columns(criteria):
+    """The columns of a body table whose bodies these criteria judge: the shared ones and each
+    criterion's own (a name two criteria declare must mean the same column)."""
+    columns = dict(SHARED_COLUMNS)
+    for criterion in criteria:
+        for name, spec in criterion.columns.items():
+            if columns.setdefault(name, spec) != spec:
+                raise ValueError(f"body-table column {name!r}: {type(criterion).__name__} "
+                                 f"declares {spec}, another part {columns[name]}")
+    return columns
 
 
 class BodyTable:
     """Per-body state in numpy columns indexed by body id (grown as bodies appear).
 
     `table[i]` is a BodyRow: a live view of body i's row (read and write by field name).
-    It iterates like a dict {id: row} over the bodies yadebreak knows.
+    It iterates like a dict {id: row} over the bodies yadebreak knows. `spec`: its columns,
+    {name: (dtype, value of a new row)} (assembled_columns; default: the shared ones).
     """
 
-    def __init__(self, labels=()):
+    def __init__(self, labels=(), spec=None):
         self.labels = list(labels)            # material labels; `material` holds their index
+        self.spec = dict(SHARED_COLUMNS if spec is None else spec)
         self.size = 0
-        self.columns = {name: np.empty(0, dtype) for name, (dtype, _) in _COLUMNS.items()}
+        self.columns = {name: np.empty(0, dtype) for name, (dtype, _) in self.spec.items()}
         self.known = {}                       # id -> None, in the order bodies were adopted
 
     def _grow(self, top):
         if top < self.size:
             return
         size = max(top + 1, 2 * self.size, 64)
-        for name, (dtype, fill) in _COLUMNS.items():
+        for name, (dtype, fill) in self.spec.items():
             column = np.full(size, fill, dtype)
             column[:self.size] = self.columns[name][:self.size]
             self.columns[name] = column
@@ -84,7 +95,7 @@ class BodyTable:
             return
         self._grow(int(ids.max()))
         c = self.columns
-        for name, (_, fill) in _COLUMNS.items():
+        for name, (_, fill) in self.spec.items():
             c[name][ids] = fill
         c["kind"][ids] = kind
         c["material"][ids] = self.labels.index(material) if isinstance(material, str) else material
@@ -131,15 +142,17 @@ class BodyTable:
     def to_dict(self):
         ids = self.ids()
         return {"labels": self.labels, "ids": ids.tolist(),
-                "columns": {name: _listed(self.columns[name][ids]) for name in _COLUMNS}}
+                "columns": {name: _listed(self.columns[name][ids]) for name in self.spec}}
 
     @classmethod
-    def from_dict(cls, data):
-        table = cls(data["labels"])
+    def from_dict(cls, data, spec=None):
+        """The table saved by to_dict, with the columns `spec` (see BodyTable): a saved column
+        it lacks is not read, one it has that was not saved starts at its new-row value."""
+        table = cls(data["labels"], spec)
         ids = np.asarray(data["ids"], dtype=np.int64)
         if len(ids):
             table._grow(int(ids.max()))
-            for name, (dtype, _) in _COLUMNS.items():
+            for name, (dtype, _) in table.spec.items():
                 if name not in data["columns"]:      # a column added since the state was saved
                     continue                          # (_grow filled it with its new-row value)
                 table.columns[name][ids] = np.asarray(data["columns"][name], dtype=float).astype(dtype)
@@ -183,7 +196,7 @@ class BodyRow:
         table.columns[name][self.id] = value
 
     def as_dict(self):
-        return {name: getattr(self, name) for name in _COLUMNS}
+        return {name: getattr(self, name) for name in self._table.spec}
 
     def __repr__(self):
         return f"BodyRow({self.id}, {self.as_dict()})"
@@ -298,8 +311,8 @@ class EngineState:
     stressing event, the event log, the fines ledger, the random stream, the top size (m) and
     the warnings given."""
 
-    def __init__(self, labels, seed, event_log=None):
-        self.table = BodyTable(labels)
+    def __init__(self, labels, seed, event_log=None, columns=None):
+        self.table = BodyTable(labels, columns)
         self.tracked = set()
         self.open_events = set()
         self.log = EventLog(event_log)
@@ -322,10 +335,11 @@ class EngineState:
                 "top_size": self.top_size, "warned": sorted(self.warned)}
 
     @classmethod
-    def from_dict(cls, data, event_log=None):
+    def from_dict(cls, data, event_log=None, columns=None):
+        """The state saved by to_dict; `columns`: its body table's (assembled_columns)."""
         check_format(data)
         self = cls(data["table"]["labels"], 0, event_log)
-        self.table = BodyTable.from_dict(data["table"])
+        self.table = BodyTable.from_dict(data["table"], columns)
         self.tracked = set(data["tracked"])
         # open events are those with an energy recorded (built in id order, as at any restore)
         event_max = self.table.columns["event_max"]

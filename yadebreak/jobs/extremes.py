@@ -10,7 +10,6 @@ YADE is reached through the scenes (scenes/extremes.py, scenes/view.py).
 from __future__ import annotations
 
 import csv
-import dataclasses
 import json
 import math
 import time
@@ -22,7 +21,7 @@ import numpy as np
 from yadebreak import engine, scenes
 from yadebreak.engine import attach
 from yadebreak.scenes import extremes as extreme_scenes, view
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import mark_finished, progress
 
 SIZE = 5.5e-3
@@ -39,8 +38,9 @@ class Case:
 
 
 def _material(name="limestone", **changes):
+    """The material `name` with some of its criterion's parameters changed (SI)."""
     mat = load_material(name)
-    return dataclasses.replace(mat, **changes) if changes else mat
+    return mat.with_params(**changes) if changes else mat
 
 
 def _impact(size=SIZE, speed=20.0, material=None, **options):
@@ -124,10 +124,10 @@ def cases():
         Case("fragments against a wall and facets", _in_facet_corner, n=10, n_fast=3),
         Case("neighbours breaking in the same step", _head_on, n=10, n_fast=2,
              expect={"min_breakages_one_step": 2}),
-        Case("Ab-T10, S x 1e-3", _impact(speed=40.0, material=dataclasses.replace(
-            ab, selection=ab.selection * 1e-3))),
-        Case("Ab-T10, S x 1e3, e_min = 0", _impact(speed=5.0, material=dataclasses.replace(
-            ab, selection=ab.selection * 1e3, e_min_ref=0.0))),
+        Case("Ab-T10, S x 1e-3", _impact(speed=40.0, material=ab.with_params(
+            selection=ab.params.selection * 1e-3))),
+        Case("Ab-T10, S x 1e3, e_min = 0", _impact(speed=5.0, material=ab.with_params(
+            selection=ab.params.selection * 1e3, e_min_ref=0.0))),
     ]
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from yadebreak import engine, scenes
 from yadebreak.scenes import view
 from yadebreak.analysis import reports
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 from yadebreak.jobs import paraview, skeleton
 from yadebreak.jobs.lifecycle import (ScriptError, progress, resume_arguments, save_figure,
                                        time_left, write_atomic)
@@ -184,7 +184,7 @@ class Repeated(skeleton.Job):
             if self.mat.criterion.name != "tavares":
                 raise ScriptError(f"--gamma applies to Tavares materials; {self.mat.name} uses "
                                   f"{self.mat.criterion.name}")
-            self.mat = dataclasses.replace(self.mat, gamma=args.gamma)
+            self.mat = self.mat.with_params(gamma=args.gamma)
         self.share = self.mat.energy_partition(load_material(args.target))
         self.speed = float(np.sqrt(2 * args.energy))
         self.began = time.time()
@@ -244,10 +244,10 @@ def _repeated_outputs(args, mat, share, fractions, brk, out, runtime_s, end_reas
     criterion = mat.criterion
     model_fractions = criterion.repeated_broken_fraction(share * args.energy, args.size,
                                                          len(fractions))
-    model_label = criterion.repeated_label.format(gamma=mat.gamma)
+    model_label = criterion.repeated_label.format(**dataclasses.asdict(mat.params))
     absorbed = [e["specific_energy"] for e in brk.events if e["kind"] == "damage"]
     summary = {"material": mat.name, "model": mat.breakage_model, "size": args.size,
-               "energy": args.energy, "gamma": mat.gamma,
+               "energy": args.energy, "gamma": getattr(mat.params, "gamma", None),
                "particles": args.particles, "share_e": share,
                "broken_fraction": fractions, "model_broken_fraction": model_fractions.tolist(),
                "mean_absorbed_specific_energy": float(np.mean(absorbed)) if absorbed else None,

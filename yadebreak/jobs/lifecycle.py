@@ -22,11 +22,11 @@ from pathlib import Path
 from yadebreak.model.intervals import InputError
 
 from yadebreak.options.flags import debugging, fail, script_option_names
-from yadebreak.process.errors import _first_line, disk_full, error_line  # noqa: F401
+from yadebreak.process.errors import disk_full, error_line, first_line
 from yadebreak.process.files import append_whole, save_figure, write_atomic, write_whole  # noqa: F401
-from yadebreak.process.signals import (  # noqa: F401
-    _STOP, Interrupted, _catch_signals, _on_signal, _restore_signals, _signal_name, stop_point,
-    stop_points, stop_requested)
+from yadebreak.process.signals import (Interrupted, catch_signals, restore_signals, signal_name,
+                                       stop_requested, stop_signal)
+from yadebreak.process.signals import stop_point, stop_points  # noqa: F401 (skeleton's)
 
 class ScriptError(InputError):
     """A user's mistake that a script reports in one line (exit code 2), e.g. a resume with other
@@ -55,7 +55,7 @@ def run_script(main, *args):
     close_remote_access()
     out = getattr(args[0], "out", None) if args else None
     began = time.time()
-    handlers = _catch_signals()
+    handlers = catch_signals()
     try:
         with (nullcontext() if out is None else own_out(out, args[0])), warnings_shown_once():
             return main(*args)
@@ -76,17 +76,17 @@ def run_script(main, *args):
         _end_interrupted(exc, out, began)
     except Exception as exc:             # a failure midway
         if stop_requested():             # a signal that struck inside a PyRunner: YADE wraps it
-            _end_interrupted(Interrupted(_STOP["signal"]), out, began)
+            _end_interrupted(Interrupted(stop_signal()), out, began)
         if disk_full(exc) and not debugging():
             print(f"[yadebreak] error: the disk is full ({error_line(exc)}): the run stopped; "
                   f"{kept_outputs(out, began)}", file=sys.stderr, flush=True)
             raise SystemExit(1) from None
         traceback.print_exc()            # for a bug report
-        print(f"[yadebreak] error: the run failed ({type(exc).__name__}: {_first_line(exc)}); "
+        print(f"[yadebreak] error: the run failed ({type(exc).__name__}: {first_line(exc)}); "
               f"{kept_outputs(out, began)}", file=sys.stderr, flush=True)
         raise SystemExit(1) from None
     finally:
-        _restore_signals(handlers)
+        restore_signals(handlers)
     fail(message)
 
 
@@ -100,7 +100,7 @@ def close_remote_access():
 
 
 def _end_interrupted(exc, out, began):
-    progress(f"interrupted ({_signal_name(getattr(exc, 'signum', signal.SIGINT))}): "
+    progress(f"interrupted ({signal_name(getattr(exc, 'signum', signal.SIGINT))}): "
              f"{kept_outputs(out, began)}")
     raise SystemExit(getattr(exc, "exit_code", 128 + signal.SIGINT)) from None
 
@@ -296,7 +296,7 @@ def read_checkpoint(path, load):
                 while f.read(1 << 20):
                     pass
     except (OSError, EOFError, ValueError, zlib.error) as exc:
-        raise ScriptError(f"--resume: {path} is damaged ({_first_line(exc)}): {again}") from exc
+        raise ScriptError(f"--resume: {path} is damaged ({first_line(exc)}): {again}") from exc
     try:
         return load(path)
     except (ScriptError, RunFinished):
@@ -304,7 +304,7 @@ def read_checkpoint(path, load):
     except OSError as exc:
         raise ScriptError(f"--resume: {path} cannot be resumed here ({exc})") from exc
     except Exception as exc:
-        raise ScriptError(f"--resume: {path} is damaged ({_first_line(exc) or type(exc).__name__}"
+        raise ScriptError(f"--resume: {path} is damaged ({first_line(exc) or type(exc).__name__}"
                           f"): {again}") from exc
 
 
@@ -327,7 +327,7 @@ def partial_outputs_on_failure(write):
         raise
     except Exception as exc:
         if stop_requested():             # the signal struck inside a PyRunner: YADE wrapped it
-            _write_partial(write, "interrupted", Interrupted(_STOP["signal"]).end_message)
+            _write_partial(write, "interrupted", Interrupted(stop_signal()).end_message)
         else:
             _write_partial(write, "error", error_line(exc) if disk_full(exc)
                            else f"{type(exc).__name__}: {exc}")
@@ -473,7 +473,7 @@ class PartialResults:
             if not (isinstance(arguments, dict) and isinstance(done, dict)):
                 raise ValueError("'arguments' and 'done' must be objects")
         except (ValueError, KeyError, TypeError) as exc:     # UnicodeDecodeError is a ValueError
-            raise ScriptError(f"{refuse} is damaged ({type(exc).__name__}: {_first_line(exc)}): "
+            raise ScriptError(f"{refuse} is damaged ({type(exc).__name__}: {first_line(exc)}): "
                               "it cannot be resumed; run again without --resume") from None
         check_resume_arguments(arguments, self.args, self.path)
         if "digest" in data and data["digest"] != _digest(done):
@@ -485,7 +485,7 @@ class PartialResults:
                     validate(key, result)
             except (ValueError, KeyError, TypeError) as exc:
                 raise ScriptError(f"{refuse}: the result for {key} is not one this run could "
-                                  f"have written ({_first_line(exc)}); run again without "
+                                  f"have written ({first_line(exc)}); run again without "
                                   "--resume") from None
         return done
 

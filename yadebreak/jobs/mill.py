@@ -287,8 +287,9 @@ def _write_histories(out, loop, power, edges, spectra):
 def _write_grinding_spectra(out):
     """spectra.csv for `python3 -m yadebreak grind` (docs/grinding.md, Section 2), from this
     run's summary.json and collision_spectra.csv."""
+    from yadebreak.criteria import load_material
     from yadebreak.model.spectra import SPECTRA_NAME, from_mill_run, write_spectra
-    write_spectra(out / SPECTRA_NAME, from_mill_run(out))
+    write_spectra(out / SPECTRA_NAME, from_mill_run(out, load_material))
 
 
 def _plots(out, summary, loop, info, power, edges, spectra):

@@ -127,7 +127,8 @@ BED_IMPACT = JobOptions(
 def _wave_speed(material):
     """sqrt(E/rho) of `material` (a name or a file), or None if it does not load (the run reports
     why, in its own one line)."""
-    from yadebreak.model.materials import MaterialError, load_material
+    from yadebreak.model.materials import MaterialError
+    from yadebreak.criteria import load_material
     try:
         mat = load_material(material)
     except (MaterialError, OSError):

@@ -1,7 +1,7 @@
 """The model layer: the breakage model as plain numpy/scipy; nothing here imports yade.
 
     from yadebreak import model
-    model.t10(1000.0, material.A, material.b)      # the equations are re-exported here
+    model.t10(1000.0, p.A, p.b_prime, p.kappa)   # p = material.params; the equations are re-exported here
 
 equations   the Tavares UFRJ model, one function per equation (docs/model.md numbers them)
 materials   material files (TOML) read, checked and converted to SI once

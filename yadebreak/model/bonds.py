@@ -23,8 +23,8 @@ from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
 from yadebreak.model.intervals import DENSITY, PARTICLE_SIZE, POISSON_RATIO, YOUNG_MODULUS
-from yadebreak.model.materials import (MaterialError, _check_keys, _find, _read_table, read_number,
-                        available_materials, in_file_unit)
+from yadebreak.model.materials import (Key, MaterialError, available_materials, check_keys,
+                                       find_material_file, read_keys, read_table)
 
 #: failure modes, as stored per bond (index) and written in outputs (name)
 MODES = ("intact", "tension", "shear", "compression")
@@ -81,39 +81,32 @@ class AgglomerateMaterial:
                                    Binder(**fields))
 
 
-# (key, lo, lo inclusive, hi, hi inclusive, unit as written in the file, factor to SI)
-_SPHERE_KEYS = [
-    ("density", *in_file_unit(DENSITY, 1.0), "kg/m3", 1.0),
-    ("young_modulus", *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", 1e9),
-    ("poisson_ratio", *in_file_unit(POISSON_RATIO, 1.0), "-", 1.0),
-    ("friction", 0.0, True, 10.0, True, "-", 1.0),
-    ("rolling_friction", 0.0, True, 1.0, True, "-", 1.0),
-    ("restitution", 0.0, False, 1.0, True, "-", 1.0),
-    ("diameter_mean", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
-    ("diameter_sd", 0.0, True, 1000.0, True, "mm", 1e-3),
-    ("diameter_min", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
-    ("diameter_max", *in_file_unit(PARTICLE_SIZE, 1e-3), "mm", 1e-3),
-]
-_BINDER_KEYS = [
-    ("young_modulus", *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", 1e9),
-    ("poisson_ratio", *in_file_unit(POISSON_RATIO, 1.0), "-", 1.0),
-    ("tensile_strength", 0.0, False, 1e5, True, "MPa", 1e6),
-    ("shear_strength", 0.0, False, 1e5, True, "MPa", 1e6),
-    ("compressive_strength", 0.0, False, 1e6, True, "MPa", 1e6),
-    ("strength_cv", 0.0, True, 0.5, True, "-", 1.0),
-    ("radius_multiplier", 0.0, False, 1.0, True, "-", 1.0),
-    ("contact_radius_multiplier", 1.0, True, 2.0, True, "-", 1.0),
-]
+_SPHERE_KEYS = (
+    Key.of("density", DENSITY, "kg/m3"),
+    Key.of("young_modulus", YOUNG_MODULUS, "GPa", 1e9),
+    Key.of("poisson_ratio", POISSON_RATIO, "-"),
+    Key("friction", 0.0, True, 10.0, True, "-"),
+    Key("rolling_friction", 0.0, True, 1.0, True, "-"),
+    Key("restitution", 0.0, False, 1.0, True, "-"),
+    Key.of("diameter_mean", PARTICLE_SIZE, "mm", 1e-3),
+    Key("diameter_sd", 0.0, True, 1000.0, True, "mm", 1e-3),
+    Key.of("diameter_min", PARTICLE_SIZE, "mm", 1e-3),
+    Key.of("diameter_max", PARTICLE_SIZE, "mm", 1e-3),
+)
+_BINDER_KEYS = (
+    Key.of("young_modulus", YOUNG_MODULUS, "GPa", 1e9),
+    Key.of("poisson_ratio", POISSON_RATIO, "-"),
+    Key("tensile_strength", 0.0, False, 1e5, True, "MPa", 1e6),
+    Key("shear_strength", 0.0, False, 1e5, True, "MPa", 1e6),
+    Key("compressive_strength", 0.0, False, 1e6, True, "MPa", 1e6),
+    Key("strength_cv", 0.0, True, 0.5, True, "-"),
+    Key("radius_multiplier", 0.0, False, 1.0, True, "-"),
+    Key("contact_radius_multiplier", 1.0, True, 2.0, True, "-"),
+)
 
 
 def _section(doc, name, keys, problems):
-    table = _read_table(doc, name, "", problems)
-    _check_keys(table, {k[0] for k in keys}, name, problems)
-    values = {}
-    for key, lo, lo_inc, hi, hi_inc, unit, factor in keys:
-        v = read_number(table, key, name, problems, lo, lo_inc, hi, hi_inc, unit)
-        values[key] = None if v is None else v * factor
-    return values
+    return read_keys(read_table(doc, name, "", problems), keys, name, problems)
 
 
 def load_agglomerate_material(name_or_path):
@@ -123,7 +116,7 @@ def load_agglomerate_material(name_or_path):
     text = str(name_or_path)
     path = Path(text)
     if not (text.endswith(".toml") or path.exists()):
-        path = _find(text)
+        path = find_material_file(text)
         if path is None:
             names = ", ".join(available_materials(kind="bonded_agglomerate"))
             raise MaterialError(text, [f"unknown material '{text}': available are {names} (or a "
@@ -135,7 +128,7 @@ def load_agglomerate_material(name_or_path):
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise MaterialError(path, [f"not valid TOML: {exc}"]) from None
     problems = []
-    _check_keys(doc, {"name", "description", "kind", "spheres", "binder"}, "(top level)", problems)
+    check_keys(doc, {"name", "description", "kind", "spheres", "binder"}, "(top level)", problems)
     if doc.get("kind") != "bonded_agglomerate":
         problems.append(f"kind: must be \"bonded_agglomerate\" for an agglomerate material, got "
                         f"{doc.get('kind')!r} (a replacement-model material is read by "

@@ -4,6 +4,12 @@ A material name ('copper_ore') is looked for in the folders of material_search_p
 in $YADEBREAK_MATERIALS, then the working folder's materials/, then the files shipped with the
 package (yadebreak/data/materials, also reached as materials/ at the top of the repository).
 
+This module reads what every material shares: [elastic], [contact.*], and of [breakage] the
+criterion's name (`model`), the fragments' global damping and Eq. 10's table. The rest of
+[breakage] belongs to the criterion it names, which parses it into its parameter object
+(`Material.params`): parse() takes the registry of criteria from its caller
+(yadebreak.criteria.load_material), since this room may not import them.
+
 A file states its units as the paper prints them (mm, GPa, %); the Material object holds SI values
 (m, Pa) except t10-related percentages (A), which stay in percent like t10 itself.
 Never imports yade.
@@ -13,11 +19,12 @@ from __future__ import annotations
 import math
 import os
 import tomllib
+import dataclasses
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 from types import MappingProxyType
-from typing import Mapping
+from typing import Mapping, NamedTuple
 
 import numpy as np
 
@@ -51,7 +58,9 @@ class ContactParams:
 
 @dataclass(frozen=True)
 class Material:
-    """An immutable material. SI units: density kg/m3, young_modulus Pa, d0 m, energies J/kg."""
+    """An immutable material: what every material has (SI units: density kg/m3, young_modulus Pa)
+    and, for a breakable one, its criterion's parameters as one object (`params`, the class its
+    criterion declares; None for a material that does not break)."""
 
     name: str
     source: str
@@ -62,35 +71,35 @@ class Material:
     poisson_ratio: float
     contacts: Mapping[str, ContactParams]
     contact_like: str | None = None
+    #: the file's breakage.model, the name of the criterion (None for a material that does not
+    #: break)
     breakage_model: str | None = None
-    # Tavares breakage parameters (None for non-breakable materials)
-    e_inf: float | None = None
-    d0: float | None = None
-    phi: float | None = None
-    sigma: float | None = None
-    emax_ratio: float | None = None
-    gamma: float | None = None
-    A: float | None = None
-    b_prime: float | None = None
-    kappa: float | None = None
+    #: the criterion's parameters (yadebreak.criteria: Tavares's, Ab-T10's), SI
+    params: object = None
     #: the paper's global damping of fresh fragments (0.3 for copper ore, 0 otherwise); attach's
     #: global_damping overrides it (docs/high_energy.md, "Global damping")
     global_damping: float = 0.0
-    device_stiffness: float = model.DEVICE_STIFFNESS_STEEL
     beta_params: Mapping[float, tuple] | None = None
     beta_source: str | None = None
-    # Ab-T10 parameters (docs/model.md Section 9; None unless breakage_model == "ab_t10")
-    e_min_ref: float | None = None       # J/kg, at size_ref
-    size_ref: float | None = None        # m
-    selection: float | None = None       # S, kg/J
-    t10_max: float | None = None         # M, %
+
+    def __getattr__(self, name):
+        params = self.__dict__.get("params")
+        if params is not None and hasattr(params, name):
+            raise AttributeError(f"Material has no attribute {name!r}: it is a parameter of its "
+                                 f"criterion, material.params.{name}")
+        raise AttributeError(f"'Material' object has no attribute {name!r}")
+
+    def with_params(self, **changes):
+        """The same material with some of its criterion's parameters changed (SI)."""
+        return dataclasses.replace(self, params=dataclasses.replace(self.params, **changes))
 
     @cached_property
     def criterion(self):
-        """This material's breakage criterion (an object of a class of CRITERIA, named by its
-        file's breakage.model; Tavares when none): the one place where the criterion is chosen,
-        made once per material, so the model and the engine ask the same object."""
-        return CRITERIA[self.breakage_model or "tavares"](self)
+        """This material's breakage criterion, made by its parameters' class (the criterion the
+        file names): the one place where the criterion is chosen, made once per material, so the
+        model and the engine ask the same object."""
+        self._need_breakable("breakage criterion")
+        return self.params.criterion(self)
 
     @property
     def is_ab_t10(self):
@@ -204,35 +213,53 @@ class Material:
 
 
 # ------------------------------------------------------------------------------- validation
-def in_file_unit(interval, factor):
-    """(lower, lower inclusive, upper, upper inclusive) of a physical range (intervals.py, SI) in
-    a file's unit worth `factor` SI units (GPa: 1e9)."""
-    unit = interval.scaled(factor)
-    return unit.lo, not unit.lo_open, unit.hi, not unit.hi_open
+class Key(NamedTuple):
+    """One number of a material file: its name, the accepted range in the file's unit (bounds
+    and whether each is accepted), that unit, the factor to SI, and its default (None:
+    required)."""
+
+    name: str
+    lo: float
+    lo_inclusive: bool
+    hi: float
+    hi_inclusive: bool
+    unit: str
+    factor: float = 1.0
+    default: float | None = None
+
+    @classmethod
+    def of(cls, name, interval, unit, factor=1.0, default=None):
+        """The key of a physical range (intervals.py, SI) read in a file unit worth `factor` SI
+        units (GPa: 1e9)."""
+        scaled = interval.scaled(factor)
+        return cls(name, scaled.lo, not scaled.lo_open, scaled.hi, not scaled.hi_open, unit,
+                   factor, default)
+
+    def read(self, table, where, problems, required=True):
+        """The key's value in `table` in SI (its default, or None and a problem, if absent or
+        wrong)."""
+        value = read_number(table, self.name, where, problems, self.lo, self.lo_inclusive,
+                            self.hi, self.hi_inclusive, self.unit, required, self.default)
+        return None if value is None else value * self.factor
 
 
-# (key, lower, lower inclusive, upper, upper inclusive, unit in file, SI factor)
-_ELASTIC = [
-    ("density", *in_file_unit(DENSITY, 1.0), "kg/m3", 1.0),
-    ("young_modulus", *in_file_unit(YOUNG_MODULUS, 1e9), "GPa", 1e9),
-    ("poisson_ratio", *in_file_unit(POISSON_RATIO, 1.0), "-", 1.0),
-]
-#: optional for every breakage model: the damping of fresh fragments (docs/high_energy.md); a
-#: [breakage] key of each criterion's `keys`
-GLOBAL_DAMPING_KEY = ("global_damping", 0.0, True, 1.0, False, "-", 1.0)
-_CONTACT = [
-    ("friction", 0.0, True, 10.0, True, "-", 1.0),
-    ("rolling_friction", 0.0, True, 10.0, True, "-", 1.0),
-    ("restitution", 0.0, False, 1.0, True, "-", 1.0),
-]
+def read_keys(table, keys, where, problems):
+    """{key name: SI value or None} of `keys` in `table`, unknown keys reported."""
+    check_keys(table, {k.name for k in keys}, where, problems)
+    return {k.name: k.read(table, where, problems) for k in keys}
 
 
-# ------------------------------------------------------------------- the breakage criteria
-#: breakage.model -> its criterion class (yadebreak.criteria: one class per criterion, holding
-#: its [breakage] keys, distribution, t10 and engine side): the one registry. This room may not
-#: import the criteria, so they register here (criteria.base.register) when `import yadebreak`
-#: imports them; the parser and Material.criterion read it.
-CRITERIA = {}
+_ELASTIC = (Key.of("density", DENSITY, "kg/m3"), Key.of("young_modulus", YOUNG_MODULUS, "GPa", 1e9),
+            Key.of("poisson_ratio", POISSON_RATIO, "-"))
+_CONTACT = (Key("friction", 0.0, True, 10.0, True, "-"),
+            Key("rolling_friction", 0.0, True, 10.0, True, "-"),
+            Key("restitution", 0.0, False, 1.0, True, "-"))
+#: the [breakage] keys every criterion shares: the criterion's name, Eq. 10's table and where it
+#: comes from, and the damping of fresh fragments (docs/high_energy.md)
+GLOBAL_DAMPING = Key("global_damping", 0.0, True, 1.0, False, "-", 1.0, 0.0)
+SHARED_BREAKAGE_KEYS = frozenset({"model", "beta", "beta_source", GLOBAL_DAMPING.name})
+#: the criterion a [breakage] table without `model` names
+DEFAULT_CRITERION = "tavares"
 
 
 _TOP_KEYS = {"name", "description", "kind", "breakable", "contact_like", "elastic", "breakage",
@@ -273,13 +300,15 @@ def read_number(table, key, where, problems, lo, lo_inc, hi, hi_inc, unit, requi
     return value
 
 
-def _check_keys(table, allowed, where, problems):
+def check_keys(table, allowed, where, problems):
+    """Report every key of `table` not in `allowed`."""
     for key in table:
         if key not in allowed:
             problems.append(f"{where}.{key}: unknown key (allowed: {', '.join(sorted(allowed))})")
 
 
-def _read_table(doc, key, where, problems, required=True):
+def read_table(doc, key, where, problems, required=True):
+    """The sub-table `key` of `doc` ({} and a problem if absent or not a table)."""
     value = doc.get(key)
     if value is None:
         if required:
@@ -291,13 +320,16 @@ def _read_table(doc, key, where, problems, required=True):
     return value
 
 
-def _parse(doc, source):
+def parse(doc, source, criteria):
+    """The Material of a parsed TOML document `doc` read from `source`; `criteria`: {name:
+    criterion class} of the criteria a file may name (the class parses its own [breakage] keys:
+    criteria.base.Criterion.parse). Raises MaterialError listing every problem."""
     problems = []
     if doc.get("kind", "replacement") != "replacement":
         raise MaterialError(source, [f"kind = {doc.get('kind')!r}: a bonded-agglomerate material, "
                                      "read by yadebreak.model.bonds.load_agglomerate_material (this "
                                      "reader takes kind = \"replacement\")"])
-    _check_keys(doc, _TOP_KEYS, "(top level)", problems)
+    check_keys(doc, _TOP_KEYS, "(top level)", problems)
     name = doc.get("name", Path(source).stem)
     if not isinstance(name, str) or not name:
         problems.append(f"name: must be a non-empty string, got {name!r}")
@@ -315,65 +347,53 @@ def _parse(doc, source):
         contact_like = None
     values = _parse_elastic(doc, problems)
     contacts = _parse_contacts(doc, contact_like, problems)
-    model_name, beta_params, beta_source = None, None, None
+    breakage = {}
     if breakable:
-        model_name, beta_params, beta_source = _parse_breakage(doc, values, problems)
+        breakage = _parse_breakage(doc, criteria, problems)
     elif "breakage" in doc:
         problems.append("breakage: given for a material with breakable = false")
     if problems:
         raise MaterialError(source, problems)
     return Material(name=name, source=str(source), description=description, breakable=breakable,
                     contacts=MappingProxyType(contacts), contact_like=contact_like,
-                    breakage_model=model_name, beta_params=beta_params, beta_source=beta_source,
-                    **values)
+                    **values, **breakage)
 
 
 def _parse_elastic(doc, problems):
     """[elastic]: {key: SI value or None}."""
-    elastic = _read_table(doc, "elastic", "", problems)
-    _check_keys(elastic, {k[0] for k in _ELASTIC}, "elastic", problems)
-    values = {}
-    for key, lo, lo_inc, hi, hi_inc, unit, factor in _ELASTIC:
-        v = read_number(elastic, key, "elastic", problems, lo, lo_inc, hi, hi_inc, unit)
-        values[key] = None if v is None else v * factor
-    return values
+    return read_keys(read_table(doc, "elastic", "", problems), _ELASTIC, "elastic", problems)
 
 
 def _parse_contacts(doc, contact_like, problems):
     """[contact.<other>] tables: {other: ContactParams}."""
     contacts = {}
-    contact_doc = _read_table(doc, "contact", "", problems, required=contact_like is None)
+    contact_doc = read_table(doc, "contact", "", problems, required=contact_like is None)
     for other, table in contact_doc.items():
         where = f"contact.{other}"
         if not isinstance(table, dict):
             problems.append(f"{where}: must be a table")
             continue
-        _check_keys(table, {k[0] for k in _CONTACT}, where, problems)
-        got = [read_number(table, k, where, problems, lo, li, hi, hi_i, u)
-               for k, lo, li, hi, hi_i, u, _ in _CONTACT]
-        if None not in got:
-            contacts[other] = ContactParams(*got)
+        got = read_keys(table, _CONTACT, where, problems)
+        if None not in got.values():
+            contacts[other] = ContactParams(**got)
     return contacts
 
 
-def _parse_breakage(doc, values, problems):
-    """[breakage] of a breakable material into `values` (SI); returns (model name, beta
-    parameters, beta source)."""
-    breakage = _read_table(doc, "breakage", "", problems)
-    model_name = breakage.get("model", "tavares")
-    if model_name not in CRITERIA:
-        accepted = " or ".join(f"{n!r}" + (" (the default)" if n == "tavares" else "")
-                               for n in CRITERIA)
+def _parse_breakage(doc, criteria, problems):
+    """[breakage] of a breakable material: the Material fields it gives (the criterion's name
+    and parameters, the global damping, Eq. 10's table and its source)."""
+    breakage = read_table(doc, "breakage", "", problems)
+    model_name = breakage.get("model", DEFAULT_CRITERION)
+    if model_name not in criteria:
+        accepted = " or ".join(f"{n!r}" + (" (the default)" if n == DEFAULT_CRITERION else "")
+                               for n in criteria)
         problems.append(f"breakage.model = {model_name!r}: accepted {accepted}")
-        model_name = "tavares"
-    criterion = CRITERIA[model_name]
-    allowed = {k[0] for k in criterion.keys} | {"model", "beta", "beta_source"}
-    _check_keys(breakage, allowed | criterion.more_keys, "breakage", problems)
-    for key, lo, lo_inc, hi, hi_inc, unit, factor in criterion.keys:
-        v = read_number(breakage, key, "breakage", problems, lo, lo_inc, hi, hi_inc, unit,
-                        default=criterion.defaults.get(key))
-        values[key] = None if v is None else v * factor
-    criterion.parse_more(breakage, values, problems)
+        model_name = DEFAULT_CRITERION
+    criterion = criteria[model_name]
+    check_keys(breakage, SHARED_BREAKAGE_KEYS | criterion.file_keys(), "breakage", problems)
+    fields = {"breakage_model": model_name,
+              "params": criterion.parse(breakage, "breakage", problems),
+              "global_damping": GLOBAL_DAMPING.read(breakage, "breakage", problems)}
     beta_source = breakage.get("beta_source", "material")
     if beta_source not in ("material", "table1"):
         problems.append(f"breakage.beta_source = {beta_source!r}: accepted 'material' (the "
@@ -381,14 +401,15 @@ def _parse_breakage(doc, values, problems):
     if beta_source == "table1":
         if "beta" in breakage:
             problems.append("breakage.beta: given although beta_source = 'table1'; remove one")
-        return model_name, model.TABLE1_BETA_PARAMS, beta_source
-    return model_name, _parse_beta(_read_table(breakage, "beta", "breakage.", problems),
-                                   problems), beta_source
+        return {**fields, "beta_params": model.TABLE1_BETA_PARAMS, "beta_source": beta_source}
+    return {**fields, "beta_source": beta_source,
+            "beta_params": _parse_beta(read_table(breakage, "beta", "breakage.", problems),
+                                       problems)}
 
 
 def _parse_beta(beta_table, problems):
     """[breakage.beta]: {n: (alpha, beta)} for the seven n of Eq. 10, or None if incomplete."""
-    _check_keys(beta_table, set(_N_KEYS), "breakage.beta", problems)
+    check_keys(beta_table, set(_N_KEYS), "breakage.beta", problems)
     parsed = {}
     for key, n in _N_KEYS.items():
         pair = beta_table.get(key)
@@ -436,7 +457,7 @@ def _kind_of(path):
         return "replacement"
 
 
-def _find(name):
+def find_material_file(name):
     """The file of material `name` along the search path, or None."""
     for folder in material_search_path():
         path = folder / f"{name}.toml"
@@ -445,9 +466,10 @@ def _find(name):
     return None
 
 
-def load_material(name_or_path):
+def load_material(name_or_path, criteria):
     """Load and validate a material: a name ('copper_ore', looked for along
-    material_search_path()) or a path to a .toml file.
+    material_search_path()) or a path to a .toml file; `criteria`: {name: criterion class} (see
+    parse). Users call yadebreak.load_material, which gives the package's criteria.
 
     Every problem is reported at once in a MaterialError naming the file, the field and the
     accepted range. Unknown names list the available materials.
@@ -455,7 +477,7 @@ def load_material(name_or_path):
     text = str(name_or_path)
     path = Path(text)
     if not (text.endswith(".toml") or path.exists()):
-        path = _find(text)
+        path = find_material_file(text)
         if path is None:
             raise MaterialError(text, [f"unknown material '{text}': available are "
                                        f"{', '.join(available_materials())} (or give a path to a "
@@ -469,4 +491,4 @@ def load_material(name_or_path):
         doc = tomllib.loads(raw.decode("utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise MaterialError(path, [f"not valid TOML: {exc}"]) from None
-    return _parse(doc, path)
+    return parse(doc, path, criteria)

@@ -18,7 +18,6 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak.model import milling
-from yadebreak.model.materials import load_material
 from yadebreak.model.capture import CaptureModel
 
 #: a spectra file's name in a run folder (a mill's spectra run, `grind`'s conversions)
@@ -177,9 +176,10 @@ def read_spectra(path):
 
 
 # --------------------------------------------------------------------------- from a mill run
-def from_mill_run(run_dir):
+def from_mill_run(run_dir, load_material):
     """Spectra from a finished `scripts/ball_mill.py` run (its summary.json and
-    collision_spectra.csv).
+    collision_spectra.csv); `load_material`: name -> Material (yadebreak.load_material), for the
+    material the summary names.
 
     The mill records stressing events of ore particles (one per particle and event, specific
     energy Ek'/mp absorbed, J/kg) for the feed size d0 only. Under the capture model (capture.py)

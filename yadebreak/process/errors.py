@@ -3,7 +3,8 @@ import errno
 import re
 
 
-def _first_line(exc):
+def first_line(exc):
+    """The first line of an error's message ('' if it has none): YADE's errors run to several."""
     lines = str(exc).strip().splitlines()
     return lines[0] if lines else ""
 
@@ -15,8 +16,8 @@ def error_line(exc):
         if isinstance(exc, OSError):
             return f"OSError: {exc}"
         found = re.search(r"\[Errno (?:28|122)\][^\n]*", str(exc))
-        return f"OSError: {found.group(0).strip()}" if found else _first_line(exc)
-    return f"{type(exc).__name__}: {_first_line(exc)}"
+        return f"OSError: {found.group(0).strip()}" if found else first_line(exc)
+    return f"{type(exc).__name__}: {first_line(exc)}"
 
 
 def disk_full(exc):

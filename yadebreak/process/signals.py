@@ -19,17 +19,20 @@ class Interrupted(KeyboardInterrupt):
 
     @property
     def end_message(self):
-        return f"stopped by {_signal_name(self.signum)}{self.note}"
+        return f"stopped by {signal_name(self.signum)}{self.note}"
 
 
-def _signal_name(signum):
+def signal_name(signum):
+    """How end messages name a signal: 'Ctrl-C, SIGINT', 'SIGTERM'."""
     return "Ctrl-C, SIGINT" if signum == signal.SIGINT else signal.Signals(signum).name
 
 
 _STOP = {"signal": None, "points": 0}    # the signal received; depth of stop_points blocks
 
 
-def _on_signal(signum, frame):
+def on_signal(signum, frame):
+    """The handler of SIGINT and SIGTERM while a script runs: within stop_points the first signal
+    only asks the run to stop; otherwise raise Interrupted where it strikes."""
     first = _STOP["signal"] is None
     _STOP["signal"] = signum
     if _STOP["points"] and first:
@@ -37,8 +40,8 @@ def _on_signal(signum, frame):
     raise Interrupted(signum)
 
 
-def _catch_signals():
-    """SIGINT and SIGTERM to _on_signal while a script runs; returns the handlers to restore
+def catch_signals():
+    """SIGINT and SIGTERM to on_signal while a script runs; returns the handlers to restore
     (none outside the main thread, where Python cannot set them)."""
     import threading
     _STOP["signal"] = None
@@ -47,11 +50,12 @@ def _catch_signals():
     handlers = {}
     for s in (signal.SIGINT, signal.SIGTERM):
         handlers[s] = signal.getsignal(s)
-        signal.signal(s, _on_signal)
+        signal.signal(s, on_signal)
     return handlers
 
 
-def _restore_signals(handlers):
+def restore_signals(handlers):
+    """Put back the handlers catch_signals replaced, and forget the signal received."""
     for s, handler in handlers.items():
         signal.signal(s, signal.SIG_DFL if handler is None else handler)
     _STOP["signal"] = None
@@ -73,6 +77,11 @@ def stop_points():
 def stop_requested():
     """True once SIGINT or SIGTERM has been received by run_script's handlers."""
     return _STOP["signal"] is not None
+
+
+def stop_signal():
+    """The signal that asked the run to stop (None if none has): its end message names it."""
+    return _STOP["signal"]
 
 
 def stop_point(save=None):

@@ -180,8 +180,8 @@ def _holder(radius, height):
 
 
 def _material(name):
-    from yadebreak.engine.materials import _as_material
-    return _as_material(name)
+    from yadebreak.engine.materials import as_material
+    return as_material(name)
 
 
 def hold_release(info):

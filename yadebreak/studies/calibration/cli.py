@@ -10,7 +10,8 @@ import time
 from pathlib import Path
 
 from yadebreak.model.intervals import Interval, elastic_wave_speed
-from yadebreak.model.materials import MaterialError, load_material
+from yadebreak.model.materials import MaterialError
+from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import write_atomic
 from yadebreak.jobs.lifecycle import tool_run
 from yadebreak.options.flags import (ScriptParser, add_params, fail, out_option, overwrite_option,

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak import model
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 
 #: realistic test programmes: sizes (mm), particles per class, energies (J/kg)
 FRACTURE_SIZES_MM = (2.0, 4.0, 8.0, 16.0, 32.0)
@@ -26,7 +26,7 @@ PROGENY_T10 = (5.0, 10.0, 15.0, 20.0, 30.0, 40.0)
 
 def device_share(material):
     """e = 1/(1 + kp/ks): the share of the device's energy the particle absorbs (Eq. 3 / Eq. 4)."""
-    ks = material.device_stiffness if not material.is_ab_t10 else model.DEVICE_STIFFNESS_STEEL
+    ks = material.criterion.device_stiffness
     return float(model.energy_partition(material.hertz_stiffness, ks))
 
 
@@ -101,7 +101,7 @@ def repeated_rows(material, rng, series=((16.0, 0.4), (16.0, 0.6)), particles=10
                 now = alive & (absorbed > e)
                 survivors = alive & ~now
                 e[survivors] = model.weakened_fracture_energy(e[survivors], absorbed / e[survivors],
-                                                              material.gamma)
+                                                              material.params.gamma)
             alive &= ~now
             rows.append((s, energy, k, tested, int(now.sum())))
     return rows

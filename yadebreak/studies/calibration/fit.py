@@ -8,12 +8,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from yadebreak.criteria import criterion_class
 from yadebreak.studies.calibration import ab_t10, damage, data, fracture, progeny, t10
 from yadebreak.studies.calibration.mle import Estimate, FitError
-
-#: the material-file parameters of each model (breakage table), in the order they are written
-TAVARES_KEYS = ("e_inf", "d0", "phi", "sigma", "emax_ratio", "gamma", "A", "b_prime")
-AB_T10_KEYS = ("e_min_ref", "size_ref", "selection", "t10_max")
 
 
 @dataclass
@@ -43,8 +40,10 @@ def fit_all(tables, model_name="tavares", base=None, intervals=True, near=None):
     if model_name == "ab_t10" and base is None:
         raise FitError("--base: Ab-T10's e_min is an absolute energy, so the particle's share of "
                        "the device energy (its elastic constants) must come from a base material")
-    device = (fracture.Device(base.hertz_stiffness, base.device_stiffness) if base is not None
-              else fracture.Device())
+    device = fracture.Device()
+    if base is not None:            # the base's particle on the base's device (steel by default)
+        device = (fracture.Device(base.hertz_stiffness, base.criterion.device_stiffness)
+                  if base.breakable else fracture.Device(base.hertz_stiffness))
     cal = Calibration(model_name, base, device, tables)
     if model_name == "tavares":
         _tavares(cal, intervals, None if near is None else near.values.get("gamma"))
@@ -61,17 +60,25 @@ def _take(cal, result, what):
         cal.sources[name] = what
 
 
-def _from_base(cal, keys):
+def base_value(cal, key):
+    """The base material's value of the fitted criterion's `key` in the file's unit, or None
+    (no base, or a base of another criterion)."""
     base = cal.base
+    if base is None or base.breakage_model != cal.model:
+        return None
+    return getattr(base.params, key) / criterion_class(cal.model).key(key).factor
+
+
+def _from_base(cal, keys):
     for key in keys:
         if key in cal.values:
             continue
-        value = getattr(base, key, None) if base is not None else None
+        value = base_value(cal, key)
         if value is None:
             cal.missing.append(key)
             continue
-        cal.values[key] = value * (1e3 if key in ("d0", "size_ref") else 1.0)
-        cal.sources[key] = f"from base material {base.name} (not fitted: no data for it)"
+        cal.values[key] = value
+        cal.sources[key] = f"from base material {cal.base.name} (not fitted: no data for it)"
 
 
 def _tavares(cal, intervals, gamma_start=None):
@@ -81,7 +88,7 @@ def _tavares(cal, intervals, gamma_start=None):
         table = cal.tables["fracture"]
         fixed = {}
         if len(np.unique(table.columns["size"])) < fracture.MIN_CLASSES and base_tav is not None:
-            fixed = {"d0": base_tav.d0 * 1e3, "phi": base_tav.phi}
+            fixed = {k: base_value(cal, k) for k in ("d0", "phi")}
             for k, v in fixed.items():
                 cal.values[k] = v
                 cal.sources[k] = (f"from base material {base_tav.name}: fewer than "
@@ -109,7 +116,7 @@ def _tavares(cal, intervals, gamma_start=None):
 
 def _ab_t10(cal, intervals):
     base = cal.base
-    size_ref = base.size_ref * 1e3 if base.is_ab_t10 else None
+    size_ref = base_value(cal, "size_ref")
     if "fracture" in cal.tables:
         table = cal.tables["fracture"]
         if size_ref is None:

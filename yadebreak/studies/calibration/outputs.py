@@ -10,12 +10,10 @@ from pathlib import Path
 
 import numpy as np
 
+from yadebreak.criteria import criterion_class
 from yadebreak.jobs.lifecycle import save_figure, write_atomic
-from yadebreak.studies.calibration.fit import AB_T10_KEYS, TAVARES_KEYS
+from yadebreak.studies.calibration.fit import base_value
 
-UNITS = {"e_inf": "J/kg", "d0": "mm", "phi": "-", "sigma": "-", "emax_ratio": "-", "gamma": "-",
-         "A": "%", "b_prime": "-", "e_min_ref": "J/kg", "size_ref": "mm", "selection": "kg/J",
-         "t10_max": "%"}
 N_KEYS = {1.2: "1.2", 1.5: "1.5", 2.0: "2", 4.0: "4", 25.0: "25", 50.0: "50", 75.0: "75"}
 
 
@@ -37,18 +35,18 @@ def material_text(cal, name, files):
              f"young_modulus = {base.young_modulus / 1e9:.6g}   # GPa",
              f"poisson_ratio = {base.poisson_ratio:.6g}", "", "[breakage]",
              f'model = "{cal.model}"']
-    keys = TAVARES_KEYS if cal.model == "tavares" else AB_T10_KEYS
-    for key in keys:
-        value = cal.values[key]
-        est = cal.estimates.get(key)
-        why = cal.sources[key] + (f"; {_ci(est)}" if est is not None else "")
-        lines.append(f"# {key} ({UNITS[key]}): {why}")
-        lines.append(f"{key} = {value:.6g}")
-    if cal.model == "tavares":
-        kappa = base.kappa if base.breakable and not base.is_ab_t10 else 1.0
-        lines += [f"kappa = {kappa:.6g}              # Eq. 8 (not fitted)",
-                  f"device_stiffness = {cal.device.k_device / 1e9:.6g}   # GPa, the calibration "
-                  "device (Eq. 3), the base material's"]
+    criterion = criterion_class(cal.model)
+    for key in criterion.keys:
+        if key.name in criterion.calibrated:
+            est = cal.estimates.get(key.name)
+            why = cal.sources[key.name] + (f"; {_ci(est)}" if est is not None else "")
+            lines.append(f"# {key.name} ({key.unit}): {why}")
+            lines.append(f"{key.name} = {cal.values[key.name]:.6g}")
+            continue
+        value = base_value(cal, key.name)
+        whose = "the base material's" if value is not None else "the default"
+        lines.append(f"{key.name} = {key.default if value is None else value:.6g}   # "
+                     f"{'' if key.unit == '-' else key.unit + ', '}not fitted: {whose}")
     lines += ["", f"# Eq. 10, n = [alpha, beta]: {cal.beta_source}", "[breakage.beta]"]
     for n, key in N_KEYS.items():
         a, b = cal.beta[n]
@@ -102,7 +100,8 @@ def report_text(cal, plots, timings):
                    f"{e.unit} | {e.method} | {cal.sources.get(k, 'Eq. 10 fit')} |")
     for k, v in cal.values.items():
         if k not in cal.estimates:
-            out.append(f"| {k} | {_fmt(v)} | - | - | {UNITS.get(k, '')} | - | {cal.sources[k]} |")
+            unit = criterion_class(cal.model).key(k).unit
+            out.append(f"| {k} | {_fmt(v)} | - | - | {unit} | - | {cal.sources[k]} |")
     if cal.missing:
         out += ["", "Missing (no data, no base): " + ", ".join(cal.missing)]
     for note in cal.notes:

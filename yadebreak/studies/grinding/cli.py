@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak.model.intervals import PARTICLE_SIZE
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import progress, save_figure, write_atomic
 from yadebreak.options.flags import UNITS, ParamError, number, number_and_unit
 from yadebreak.studies.grinding.classes import (FeedError, class_label, feed_masses, feed_top_sieve, read_psd_csv,
@@ -43,7 +43,7 @@ def load_spectra(source, out):
     if source.is_dir():
         if (source / SPECTRA_NAME).is_file():
             return read_spectra(source / SPECTRA_NAME), source / SPECTRA_NAME
-        spectra = from_mill_run(source)
+        spectra = from_mill_run(source, load_material)
         path = write_spectra(out / SPECTRA_NAME, spectra)
         return read_spectra(path), path
     if not source.exists():

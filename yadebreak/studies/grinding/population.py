@@ -140,7 +140,7 @@ class BatchGrinder:
                                     spectra.ore_coverage)
         self.grid = FractureGrid(material.criterion, self.sizes, cells)
         self.log_e, self.width, self.fresh = self.grid.log_e, self.grid.width, self.grid.fresh
-        self.damage_table = DamageTable(material.gamma, damage)
+        self.damage_table = DamageTable(material.params.gamma, damage)
         self.log_keep = self.damage_table.log_keep
         self.breakage = Progeny(material, classes, t10_at, breakage_matrix, GrindingError)
         self.t10_grid = self.breakage.t10_grid
@@ -416,7 +416,7 @@ def _mean_mass(before, after):
 
 
 def _steel_stiffness():
-    from yadebreak.model.materials import load_material
+    from yadebreak.criteria import load_material
     return load_material("steel").hertz_stiffness
 
 

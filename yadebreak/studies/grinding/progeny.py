@@ -23,7 +23,7 @@ class Progeny:
         self.criterion, self.t10_at = material.criterion, t10_at
         self.n = classes.count
         self.matrix = None if matrix is None else self._checked(matrix, error)
-        self.t10_grid = np.linspace(material.t10_min, material.A, 101)
+        self.t10_grid = np.linspace(material.t10_min, material.params.A, 101)
         if self.matrix is None:
             self.table = self._table(material.beta_params, classes)
 

@@ -57,7 +57,8 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from yadebreak.model.materials import MaterialError, load_material
+from yadebreak.model.materials import MaterialError
+from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import progress, tool_run
 from yadebreak.options.engine_flags import Derived, Override, attach_options, engine_flag
 from yadebreak.options.flags import (integer, jobs_option, numbers, out_option, overwrite_option,

@@ -265,7 +265,7 @@ def generation_rows(r):
     rows = []
     for g in r["generations"]:
         made = g["t10_mass"] / g["mass"] if g["mass"] else None
-        eq8 = (float(equations.t10(g["stressing"] / g["fracture"], mat.A, mat.b_prime))
+        eq8 = (float(equations.t10(g["stressing"] / g["fracture"], mat.params.A, mat.params.b_prime))
                if g["fracture"] else None)
         rows.append([mat.name, f"{r['specific_energy']:g}", int(g["generation"]),
                      int(g["breakages"]), f"{100 * g['mass'] / total_mass:.1f}",
@@ -299,7 +299,7 @@ def cases(args):
     """(material, energy) of the figure: --audit-energies "target", ENERGIES where Eq. 7 (the
     model's t10 at 29 mm on steel) is at most the target's ceiling (readings.T10_CEILING %), or
     every material at each energy listed; quick: copper ore at QUICK_ENERGIES."""
-    from yadebreak.model.materials import load_material
+    from yadebreak.criteria import load_material
     from yadebreak.studies.verify.readings import T10_CEILING
     if args.quick:
         return [("copper_ore", e) for e in QUICK_ENERGIES]

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from yadebreak.model.families import CLASS_SIZES
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 from yadebreak.studies.verify import report
 from yadebreak.studies.verify.settings import (FRAGMENT_SIZE, PROBABILITY_SIZE, RT_DAMPING, RT_FRAGMENTATION, Run,
                        paper_material, paper_options, settings_text)

@@ -3,13 +3,12 @@ the first impact, which replacement cannot change) against energy and test (sing
 weight), target and restitution, size, and after repeated impacts."""
 from __future__ import annotations
 
-import dataclasses
 import json
 import time
 
 import numpy as np
 
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 from yadebreak.analysis import reports
 from yadebreak.jobs.lifecycle import progress
 from yadebreak.studies.verify import report
@@ -265,7 +264,7 @@ def repeated(runner, material, size, energy, particles, impacts, seed, options):
     fraction after each impact, kept in runner.results."""
     from yadebreak import scenes
     from yadebreak.scenes import view
-    key = json.dumps(["repeated", material.name, material.gamma, size, energy, particles, impacts,
+    key = json.dumps(["repeated", material.name, material.params.gamma, size, energy, particles, impacts,
                       seed, sorted(options.items())])
     if key not in runner.results:
         began = time.time()
@@ -277,11 +276,11 @@ def repeated(runner, material, size, energy, particles, impacts, seed, options):
             alive = scenes.impact_again(brk, alive, home, speed)
             fractions.append(1 - len(alive) / particles)
         runner.results[key] = {"test": "repeated", "material": material.name,
-                               "gamma": material.gamma, "size": size, "specific_energy": energy,
+                               "gamma": material.params.gamma, "size": size, "specific_energy": energy,
                                "particles": particles, "broken_fraction_after": fractions,
                                "scenes_at_step_limit": 0, "options": options, "seed": seed,
                                "wall_s": time.time() - began}
-        progress(f"{material.name} {1e3 * size:g} mm, gamma {material.gamma:g}: "
+        progress(f"{material.name} {1e3 * size:g} mm, gamma {material.params.gamma:g}: "
                  f"{100 * fractions[-1]:.0f} % broken after {impacts} impacts "
                  f"({time.time() - began:.0f} s)")
     return runner.results[key]
@@ -301,23 +300,23 @@ def figure_repeated(args, runner, out):
     rows, checks = [], []
     number = np.arange(1, impacts + 1)
     for k, factor in enumerate(factors):
-        mat = dataclasses.replace(base, gamma=factor * base.gamma)
+        mat = base.with_params(gamma=factor * base.params.gamma)
         r = repeated(runner, mat, REPEATED_SIZE, REPEATED_ENERGY, n, impacts, args.seed, options)
         model = mat.criterion.repeated_broken_fraction(share * REPEATED_ENERGY, REPEATED_SIZE,
                                                        impacts)
         sigma = np.sqrt(model * (1 - model) / n)
         sim = np.array(r["broken_fraction_after"])
-        ax.plot(number, 100 * model, "-", c=f"C{k}", label=f"gamma {mat.gamma:g}: model "
+        ax.plot(number, 100 * model, "-", c=f"C{k}", label=f"gamma {mat.params.gamma:g}: model "
                 "(Eqs. 1-6)")
         ax.errorbar(number, 100 * sim, yerr=reports.bounded_errors(100 * sim, 300 * sigma, 0.0,
                                                                    100.0),
-                    fmt="o", c=f"C{k}", capsize=3, label=f"gamma {mat.gamma:g}: simulation")
+                    fmt="o", c=f"C{k}", capsize=3, label=f"gamma {mat.params.gamma:g}: simulation")
         for i in range(impacts):
             off = (sim[i] - model[i]) / max(sigma[i], 1e-12)
             ok = abs(off) <= 3
-            rows.append([f"{mat.gamma:g}", i + 1, n, f"{100 * sim[i]:.1f}",
+            rows.append([f"{mat.params.gamma:g}", i + 1, n, f"{100 * sim[i]:.1f}",
                          f"{100 * model[i]:.1f}", f"{off:+.2f}", "yes" if ok else "**no**"])
-            checks.append({"what": f"gamma {mat.gamma:g} after impact {i + 1} within 3 sigma",
+            checks.append({"what": f"gamma {mat.params.gamma:g} after impact {i + 1} within 3 sigma",
                            "ok": bool(ok)})
     ax.set(xlabel="number of impacts", ylabel="broken (%)",
            title=f"Fig. 11: copper ore, {1e3 * REPEATED_SIZE:g} mm at {REPEATED_ENERGY:g} J/kg "
@@ -326,8 +325,8 @@ def figure_repeated(args, runner, out):
     text_ = settings_text(options, [COPPER_ORE], REPEATED_SIZE, n, args.seed, extra=(
         f"{impacts} impacts at {REPEATED_ENERGY:g} J/kg, each particle back to its start and "
         "fired again without spin, the broken ones leaving the test; gamma "
-        + ", ".join(f"{f * base.gamma:g}" for f in factors)
-        + f" (the file's {base.gamma:g})"))
+        + ", ".join(f"{f * base.params.gamma:g}" for f in factors)
+        + f" (the file's {base.params.gamma:g})"))
     path = report.save(fig, out / "fig11_repeated.png", text_)
     return {"name": "Fig. 11: broken fraction after repeated impacts", "plot": path.name,
             "settings": text_, "table": report.table(

@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-from yadebreak.model.materials import load_material
+from yadebreak.criteria import load_material
 from yadebreak.analysis import reports
 from yadebreak.jobs.lifecycle import progress
 from yadebreak.options.engine_flags import OPTION, Override
@@ -60,7 +60,7 @@ class Run:
 
 def paper_material(name):
     """The material as the paper's single-particle verification ran it (Emax/E50 = 4)."""
-    return dataclasses.replace(load_material(name), emax_ratio=EMAX_RATIO)
+    return load_material(name).with_params(emax_ratio=EMAX_RATIO)
 
 
 def probability_energies(material, size, levels, partner):
