@@ -49,7 +49,8 @@ if a.coverage:
     hits, reps, t0 = dict.fromkeys(names, 0), 0, time.process_time()
     for k, name in enumerate(("copper_ore", "granulite", "limestone_2", "iron_ore_1")):
         mat = load_material(name)
-        truth = {"e_inf": mat.params.e_inf, "d0": mat.params.d0 * 1e3, "phi": mat.params.phi, "sigma": mat.params.sigma}
+        tp = mat.params
+        truth = {"e_inf": tp.e_inf, "d0": tp.d0 * 1e3, "phi": tp.phi, "sigma": tp.sigma}
         rng = np.random.default_rng(1000 + k)
         for _ in range(a.coverage):
             rows = np.array(examples.fracture_rows(mat, rng, (2.0, 5.0, 12.0, 30.0), 40,

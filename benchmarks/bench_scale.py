@@ -199,7 +199,8 @@ def event_cost(sizes):
         for dummies in ("spheres", "ledger"):
             brk, _ = prepare("dense", n, "default", dummies=dummies)
             mat = brk.material["ore"]
-            ratio = -mat.params.kappa / mat.params.b_prime * np.log(1 - 10.0 / mat.params.A)   # Eq. 8 at 10 %
+            p = mat.params
+            ratio = -p.kappa / p.b_prime * np.log(1 - 10.0 / p.A)   # Eq. 8 at 10 %
             tracked = sorted(brk.state.tracked)
             victims = [tracked[len(tracked) // 2 + 7 * k] for k in range(7)]
             brk.break_body(victims[0], ratio=ratio)      # the first lowers O.dt: not counted
@@ -217,7 +218,9 @@ def event_cost(sizes):
 def _mill_args(out):
     """The default mill of scripts/ball_mill.py."""
     from argparse import Namespace
-    return Namespace(material="limestone", size=8e-3, ball_size=25e-3, drum_diameter=0.25,
+    from yadebreak import load_material
+    return Namespace(material="limestone", materials={"material": load_material("limestone")},
+                     size=8e-3, ball_size=25e-3, drum_diameter=0.25,
                      drum_length=0.1, lifters=8, lifter_height=10e-3, lifter_width=10e-3,
                      speed=0.75, ball_filling=0.3, ore_filling=0.1, duration=1.0,
                      stiffness_scale=1e-3, time_step_fraction=0.05,

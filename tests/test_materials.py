@@ -149,9 +149,9 @@ def test_a_script_refuses_an_absurd_material_in_one_line_before_running(tmp_path
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 2
     errors = [line for line in proc.stderr.splitlines() if "[yadebreak]" in line]
-    assert errors == [f"[yadebreak] error: {path}: elastic.young_modulus = 1e-300 GPa is out of "
-                      "range: accepted [0.0001, 1500] GPa"]
-    assert not (tmp_path / "o" / "summary.json").exists()
+    assert errors == [f"[yadebreak] error: --material = {path}: elastic.young_modulus = 1e-300 "
+                      "GPa is out of range: accepted [0.0001, 1500] GPa"]
+    assert not (tmp_path / "o").exists()
 
 
 def test_all_problems_reported_at_once(tmp_path):

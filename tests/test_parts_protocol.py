@@ -115,3 +115,72 @@ def test_one_runner_per_hook_calls_each_part_at_its_own_steps(scene):
     protocol.uninstall("three")
     assert not any(getattr(e, "label", "") == label for e in O.engines)
     assert not protocol.installed("two") and not protocol.installed("three")
+
+
+PART_MODULE = '''
+from yadebreak.engine.parts import protocol
+
+
+class SavedCounter(protocol.Part):
+    kind = "test_saved_counter"
+    hook = protocol.AFTER_NEWTON
+
+    def __init__(self, label, period=1, calls=0):
+        super().__init__(label, period)
+        self.calls = calls
+
+    def act(self):
+        self.calls += 1
+
+    def to_state(self, folder=None):
+        return {"calls": self.calls}
+
+    @classmethod
+    def from_state(cls, label, period, state):
+        return cls(label, period, state["calls"])
+'''
+
+PROCESS = '''
+import sys
+sys.path.insert(0, {folder!r})
+from yadebreak.adapter.yadepath import ensure_yade_importable
+ensure_yade_importable()
+from yade import O, utils
+import yadebreak
+from yadebreak.engine import run_steps
+from yadebreak.engine.parts import protocol
+'''
+
+
+def test_a_loaded_scene_finds_each_parts_module_without_importing_it_first(tmp_path):
+    """A part's kind maps to its module: the package's by PART_MODULES, a user's by the module
+    saved with its state, so a process that loads the scene need not import either first."""
+    import subprocess
+    import sys
+    from yadebreak.engine.parts import protocol
+    for kind, module in protocol.PART_MODULES.items():
+        assert protocol.part_class(kind).__module__ == module
+    (tmp_path / "user_parts.py").write_text(PART_MODULE)
+    scene = tmp_path / "scene.yade.gz"
+    save = PROCESS.format(folder=str(tmp_path)) + f'''
+import user_parts
+from yadebreak import scenes
+from yadebreak.engine import add_materials
+ip2, _ = add_materials({{"ore": "copper_ore"}})
+O.bodies.append(utils.sphere((0, 0, 0), 1e-3, material="ore"))
+O.engines = scenes.hertz_engines(ip2)
+protocol.install(user_parts.SavedCounter("counted", period=2))
+run_steps(10)
+yadebreak.save({str(scene)!r})
+'''
+    load = PROCESS.format(folder=str(tmp_path)) + f'''
+assert "user_parts" not in sys.modules
+O.load({str(scene)!r})
+run_steps(10)
+print("calls", protocol.live("test_saved_counter")["counted"].calls)
+'''
+    for code in (save, load):
+        done = subprocess.run(["/usr/bin/python3", "-c", code], capture_output=True, text=True,
+                              timeout=120)
+        assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.split()[-2:] == ["calls", "10"]           # 5 before the save, 5 after

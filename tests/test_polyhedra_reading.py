@@ -182,3 +182,28 @@ def test_cells_under_the_minimum_volume_fraction_go_to_the_ledger():
             assert min(volumes) >= (model.X_MIN * SIZE) ** 3 * (1 - 1e-12)
         assert sum(volumes) * density + brk.ledger.total_mass() == pytest.approx(mass, rel=1e-12)
     assert counts[1] < counts[0]
+
+
+@pytest.mark.parametrize("gap, checks", [(2e-4, 20), (-1e-5, 1)])
+def test_yades_do_intersect_warnings_are_silenced_and_counted(scene, capfd, gap, checks):
+    """Two 10 mm cubes face to face, their bounding boxes overlapping (a Verlet distance of
+    0.5 mm): `gap` apart, YADE would warn "Unhandled switch case:0" at each of 20 steps;
+    pressed together, once. The run shows none of it and the controller counts them."""
+    import warnings
+    from yadebreak import engine
+    from yadebreak.scenes import polyhedra as poly
+    O = scene
+    poly.polyhedra_materials({"ore": "copper_ore"}, volumetric=True, size=0.01)
+    box = poly.box_vertices(0.01, 0.01, 0.01)
+    O.bodies.append([poly.polyhedron(box, "ore", (0, 0, 0), fixed=True),
+                     poly.polyhedron(box, "ore", (0, 0, 0.01 + gap))])
+    O.engines = poly.volumetric_engines(verlet_dist=5e-4)
+    O.dt = 1e-7
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        brk = engine.attach({"ore": "copper_ore"}, seed=1, time_step_fraction=None,
+                            read_period=1)
+    assert [w.message.cause for w in said] == ["pair_checks"]
+    engine.run_steps(20)
+    assert brk.polyhedra_pair_checks == checks
+    assert "do_intersect" not in capfd.readouterr().err

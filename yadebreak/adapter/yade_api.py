@@ -79,6 +79,15 @@ def close_remote_access():
     return sorted(ports)
 
 
+def silence_polyhedra_pair_checks():
+    """Silence YADE's warnings from its polyhedra geometry (the logger of Polyhedra_support.cpp,
+    below ERROR, for this process): "Unhandled switch case:0, function do_intersect" comes at
+    every step for every pair of polyhedra whose bounding boxes overlap without touching,
+    hundreds a step in a fragment cloud (engine/contacts/volumetric.PairChecks counts them)."""
+    from yade import log
+    log.setLevel("Polyhedra_support.cpp", log.ERROR)
+
+
 def extend_match_makers(loop, more_rows):
     """Give every MatchMaker of the InteractionLoop's Ip2 functors (per-pair values such as
     `en`, `es`) the rows `more_rows(rows)` returns for its rows [(id_a, id_b, value)]. YADE's

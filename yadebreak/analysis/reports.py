@@ -91,7 +91,8 @@ class ImpactTally:
     passing's standard errors;
     scene_wall_s: the wall time (s) of the scenes added up, wherever each ran; yade_engines_s: of
     it, the time YADE's own engines took (timed by YADE; the rest is yadebreak's runners and the
-    scenes' building and checks)."""
+    scenes' building and checks); polyhedra_pair_checks: YADE's silenced do_intersect warnings
+    (polyhedra on the volumetric law; 0 otherwise)."""
     size: float
     particles: int = 0
     first: list = field(default_factory=list)
@@ -109,6 +110,7 @@ class ImpactTally:
     scene_passing: list = field(default_factory=list)
     scene_wall_s: float = 0.0
     yade_engines_s: float = 0.0
+    polyhedra_pair_checks: int = 0
 
     def __post_init__(self):
         if self.progeny_mass is None:
@@ -140,12 +142,14 @@ class ImpactTally:
         self.breakage_events += len(brk.breakage_events)
         self.initial_mass += initial_mass
         self.final_mass += brk.total_mass()
+        self.polyhedra_pair_checks += brk.polyhedra_pair_checks or 0
         self.scenes += 1
 
     def merge(self, other):
         """Add another tally of particles of the same size (another process's scenes)."""
         for name in ("particles", "breakage_events", "initial_mass", "final_mass", "scenes",
-                     "steps", "scenes_at_step_limit", "scene_wall_s", "yade_engines_s"):
+                     "steps", "scenes_at_step_limit", "scene_wall_s", "yade_engines_s",
+                     "polyhedra_pair_checks"):
             setattr(self, name, getattr(self, name) + getattr(other, name))
         self.first += other.first
         self.e_cum_intact += other.e_cum_intact

@@ -14,7 +14,7 @@ import numpy as np
 
 from yadebreak.model import families
 from yadebreak.analysis import reports
-from yadebreak.adapter.yade_api import O, utils
+from yadebreak.adapter.yade_api import O, silence_polyhedra_pair_checks, utils
 from yadebreak.engine.contacts import ContactReader, Strongest
 from yadebreak.engine.safeguards import LargeOverlaps
 from yadebreak.criteria import criterion_for
@@ -54,6 +54,13 @@ class YadebreakWarning(RuntimeWarning):
                           lambda o: f"{o} (an attach() option)")
 
 
+#: said once where the volumetric law is read (contacts/volumetric.PairChecks)
+PAIR_CHECKS_SILENCED = ("YADE's warning \"Unhandled switch case:0, function do_intersect\" is "
+                        "silenced: it comes at every step for every pair of polyhedra whose "
+                        "bounding boxes overlap without touching, harmless (docs/polyhedra.md); "
+                        "polyhedra_pair_checks counts them")
+
+
 class Controller:
     """The engine of one scene: its state, its parts, and the results (`events`,
     `size_distribution`, `body_state`). `saved`: the state of a stored scene (EngineState's
@@ -83,6 +90,9 @@ class Controller:
         self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero",
                                       config.replacement.zeroing_tolerance)
         volumetric = scene_materials.law == "volumetric"
+        if volumetric:
+            silence_polyhedra_pair_checks()
+            self.warn_once("pair_checks", PAIR_CHECKS_SILENCED)
         fast = config.reading.read_period == "fast" and not volumetric
         self.tracking = Tracking(self.state, config.reading.fast_tolerance if fast else None)
         self.schedule = ReadSchedule(config.reading, label, self.tracking.smallest_breakable,
@@ -132,6 +142,13 @@ class Controller:
     @property
     def breakage_events(self):
         return [e for e in self.events if e["kind"] == "breakage"]
+
+    @property
+    def polyhedra_pair_checks(self):
+        """YADE's silenced do_intersect warnings in this process (contacts/volumetric.PairChecks;
+        None off the volumetric law)."""
+        checks = self.reader.pair_checks
+        return None if checks is None else checks.count
 
     @property
     def ledger(self):

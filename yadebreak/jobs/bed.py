@@ -87,7 +87,7 @@ class BedImpact(skeleton.Job):
         args, energy = self.args, self.energy
         steel_rolling = getattr(args, "steel_rolling_friction", -1.0)
         self.brk, self.info = scenes.bed_impact_scene(
-            args.material, args.size, args.rings, args.layers, energy, args.seed,
+            job_options.material_of(args), args.size, args.rings, args.layers, energy, args.seed,
             packing=None if getattr(args, "packing", "auto") == "auto" else args.packing,
             rolling=bool(getattr(args, "rolling_friction", True)),
             steel_rolling_friction=None if steel_rolling < 0 else steel_rolling,
@@ -226,6 +226,7 @@ def _report(brk, info, loop, args, out, energy, runtime, end_reason, end_message
         "bed_kinetic_energy_at_touch": loop.get("bed_kinetic_energy_at_touch"),
         "rolling_friction": info["rolling_friction"],
         "energy": energy, "ball_speed": info["speed"], "seed": args.seed,
+        "outcome": brk.config.criteria.outcome,
         "particles": len(info["particles"]),
         "initial_mass": initial_mass, "final_mass": brk.total_mass(),
         "mass_relative_error": abs(brk.total_mass() - initial_mass) / initial_mass,

@@ -35,7 +35,7 @@ def _energies(args):
 # -- single impacts -------------------------------------------------------------------------------
 def single(args):
     """Every energy, then summary.json and the plot; returns the last scene's controller."""
-    mat, target = load_material(args.material), load_material(args.target)
+    mat, target = job_options.material_of(args), job_options.material_of(args, "target")
     out = Path(args.out)
     start = time.time()
 
@@ -89,8 +89,8 @@ def _impacts_at(args, mat, target, k, energy, out, start, pool=None):
                      f"{time_left(now - began, done / scenes_total)} at this energy")
 
     tally, brk = scenes.single_impacts(
-        args.material, args.size, speed, args.particles, args.scene_particles, args.seed + k,
-        target=args.target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
+        mat, args.size, speed, args.particles, args.scene_particles, args.seed + k,
+        target=target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
         jobs=args.jobs, pool=pool, shape=args.shape, watch=_frames(args, out, energy),
         **job_options.attach_options("single_impact", args))
     share = mat.energy_partition(target)
@@ -103,6 +103,8 @@ def _impacts_at(args, mat, target, k, energy, out, start, pool=None):
         "mean_specific_energy_measured": (float(np.mean([e["specific_energy"] / share
                                                          for e in intact])) if intact else None),
         "mass_relative_error": tally.mass_relative_error})
+    if args.shape == "polyhedra":
+        result["polyhedra_pair_checks"] = tally.polyhedra_pair_checks
     progress(f"{reports.result_line(result)}, {tally.steps} steps, {time.time() - start:.1f} s "
              f"(the scenes {tally.scene_wall_s:.1f} s, YADE's own engines "
              f"{tally.yade_engines_s:.1f} s of them)")
@@ -122,7 +124,7 @@ def _frames(args, out, energy):
 # -- drop-weight tests ----------------------------------------------------------------------------
 def drop_weight(args):
     """Every energy, then summary.json and the plot; returns the last energy's controller."""
-    mat, steel = load_material(args.material), load_material("steel")
+    mat, steel = job_options.material_of(args), load_material("steel")
     out = Path(args.out)
     start = time.time()
 
@@ -153,7 +155,7 @@ def drop_weight(args):
 def _drop_at(args, mat, steel, k, energy, out):
     """The drop-weight tests at `energy` (J/kg): (controller, the energy's result)."""
     brk, ids, strikers = scenes.drop_weight_scene(
-        args.material, args.size, energy, args.particles, args.striker_mass_ratio,
+        mat, args.size, energy, args.particles, args.striker_mass_ratio,
         seed=args.seed + k, event_log=str(out / f"events_{energy:g}.jsonl"),
         **job_options.attach_options("drop_weight", args))
     initial_mass = brk.total_mass()
@@ -179,20 +181,21 @@ class Repeated(skeleton.Job):
 
     def check(self):
         args = self.args
-        self.mat = load_material(args.material)
+        self.mat = job_options.material_of(args)
         if args.gamma > 0:
             if self.mat.criterion.name != "tavares":
                 raise ScriptError(f"--gamma applies to Tavares materials; {self.mat.name} uses "
                                   f"{self.mat.criterion.name}")
             self.mat = self.mat.with_params(gamma=args.gamma)
-        self.share = self.mat.energy_partition(load_material(args.target))
+        self.share = self.mat.energy_partition(job_options.material_of(args, "target"))
         self.speed = float(np.sqrt(2 * args.energy))
         self.began = time.time()
 
     def build(self):
         args = self.args
         self.brk, self.ids = scenes.impact_scene(
-            self.mat, args.size, [self.speed] * args.particles, target=args.target,
+            self.mat, args.size, [self.speed] * args.particles,
+            target=job_options.material_of(args, "target"),
             seed=args.seed, **job_options.attach_options(
                 "repeated_impact", args, event_log=str(self.out / "events.jsonl")))
         self.home = {i: view.position(i) for i in self.ids}

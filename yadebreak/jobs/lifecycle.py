@@ -23,7 +23,8 @@ from yadebreak.model.intervals import InputError
 
 from yadebreak.options.flags import debugging, fail, script_option_names
 from yadebreak.process.errors import disk_full, error_line, first_line
-from yadebreak.process.files import append_whole, save_figure, write_atomic, write_whole  # noqa: F401
+from yadebreak.process.files import (append_whole, save_figure, write_atomic,  # noqa: F401
+                                     write_whole)
 from yadebreak.process.signals import (Interrupted, catch_signals, restore_signals, signal_name,
                                        stop_requested, stop_signal)
 from yadebreak.process.signals import stop_point, stop_points  # noqa: F401 (skeleton's)
@@ -384,11 +385,11 @@ def time_left(elapsed_s, done):
 
 def resume_arguments(args):
     """The arguments that decide a run's results (not --resume, --overwrite, --stop-after, --out,
-    --checkpoint-every, --vtk-interval, --debug or --jobs): what a resumed run must share with the
-    one it continues."""
+    --checkpoint-every, --vtk-interval, --debug or --jobs, nor the Materials loaded from the
+    material options): what a resumed run must share with the one it continues."""
     return {k: v for k, v in sorted(vars(args).items())
             if k not in ("resume", "overwrite", "out", "stop_after", "checkpoint_every",
-                         "vtk_interval", "debug", "jobs")}
+                         "vtk_interval", "debug", "jobs", "materials")}
 
 
 def check_resume_arguments(saved, args, path):

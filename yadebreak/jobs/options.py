@@ -30,13 +30,15 @@ class JobOptions:
     """A job's options: its own (`own`, then `run`: the output folder, checkpoints, ...), the
     attach() options it exposes as flags (`engine`, names of the option table), its defaults
     that differ from the table's (`overrides`, exposed or fixed, each with its reason) and the
-    checks between options (`check`, of the parsed args)."""
+    checks between options (`check`, of the parsed args). `materials`: its options that name a
+    material (of the library, or a .toml file), loaded once by read() into args.materials."""
 
     own: Callable
     engine: tuple = ()
     overrides: dict = field(default_factory=dict)
     run: Callable = list
     check: Callable | None = None
+    materials: tuple = ()
 
     def params(self):
         return [*self.own(), *(engine_flag(n, self.overrides) for n in self.engine), *self.run()]
@@ -53,7 +55,8 @@ EXACT_READS = {"read_period": Override(
                   "every contact read every step, exact")}
 
 
-def laboratory_test(size, middle, out, resume_help, what, engine=(), overrides=None, check=None):
+def laboratory_test(size, middle, out, resume_help, what, engine=(), overrides=None, check=None,
+                    materials=("material",)):
     """A laboratory test (single, repeated, drop-weight impacts): the material and size, the
     job's own `middle` options, the time step and the read period (every step: EXACT_READS)
     with its `engine` options, the output folder, --resume and --stop-after counted in `what`
@@ -68,7 +71,7 @@ def laboratory_test(size, middle, out, resume_help, what, engine=(), overrides=N
             overwrite_option(),
             integer("stop_after", 0, f"(tests) end as if killed after this many {what} (0: "
                     "never)", lo=0, unit=what)],
-        check=check)
+        check=check, materials=materials)
 
 
 _KEEPING_ENERGIES = "continue the run in --out, keeping the energies it finished"
@@ -121,27 +124,15 @@ BED_IMPACT = JobOptions(
             "dummy_stiffness", "read_period", "outcome", "break_at"),
     overrides={"dummies": LEDGER},
     run=lambda: checkpointed_run_options(1e-4, "out/bed_impact"),
-    check=lambda args: _check_bed_impact(args))
-
-
-def _wave_speed(material):
-    """sqrt(E/rho) of `material` (a name or a file), or None if it does not load (the run reports
-    why, in its own one line)."""
-    from yadebreak.model.materials import MaterialError
-    from yadebreak.criteria import load_material
-    try:
-        mat = load_material(material)
-    except (MaterialError, OSError):
-        return None, None
-    return elastic_wave_speed(mat.young_modulus, mat.density), mat.name
+    check=lambda args: _check_bed_impact(args), materials=("material",))
 
 
 def check_impact_speed(option, value, speed, material, unit):
-    """Refuse an impact at or above the elastic wave speed of the particles' material, where Hertz
-    contact means nothing: one line naming the option and its largest accepted value (in `unit`,
-    the option's; the value's speed in m/s)."""
-    limit, name = _wave_speed(material)
-    if limit is None or speed < limit:
+    """Refuse an impact at or above the elastic wave speed of the particles' material (a
+    Material), where Hertz contact means nothing: one line naming the option and its largest
+    accepted value (in `unit`, the option's; the value's speed in m/s)."""
+    limit, name = elastic_wave_speed(material.young_modulus, material.density), material.name
+    if speed < limit:
         return
     bound = {"m/s": limit, "J/kg": 0.5 * limit ** 2, "J": 0.5 * BALL_MASS * limit ** 2}[unit]
     value = f"{value:g}" if isinstance(value, float) else value
@@ -156,16 +147,16 @@ def _check_specific_energies(args, option):
     value = getattr(args, option)
     energies = [float(e) for e in str(value).split(",")]
     e = max(energies)
-    check_impact_speed("--" + option.replace("_", "-"), value, math.sqrt(2.0 * e), args.material,
-                       "J/kg")
+    check_impact_speed("--" + option.replace("_", "-"), value, math.sqrt(2.0 * e),
+                       material_of(args), "J/kg")
 
 
 def _check_bed_impact(args):
     if args.speed > 0:
-        check_impact_speed("--speed", args.speed, args.speed, args.material, "m/s")
+        check_impact_speed("--speed", args.speed, args.speed, material_of(args), "m/s")
     else:
         check_impact_speed("--energy", args.energy, math.sqrt(2.0 * args.energy / BALL_MASS),
-                           args.material, "J")
+                           material_of(args), "J")
     if args.dummy_stiffness != 1.0 and args.dummies != "spheres":
         fail(f"--dummy-stiffness = {args.dummy_stiffness:g}: needs --dummies spheres (the "
              "ledger keeps no dummy spheres)")
@@ -212,7 +203,7 @@ BALL_MILL = JobOptions(
                          "fragments resolved down to a third of the feed, finer progeny to the "
                          "ledger: the bodies and the time step of a mill stay bounded")},
     run=lambda: checkpointed_run_options(0.05, "out/ball_mill"),
-    check=lambda args: _check_ball_mill(args))
+    check=lambda args: _check_ball_mill(args), materials=("material",))
 
 
 def check_mill_geometry(args):
@@ -280,7 +271,8 @@ SINGLE_IMPACT = laboratory_test(5.5e-3, [
     number("vtk_interval", 0.0, "s", "simulated time between ParaView frames of the first "
            "scene of each energy, in <out>/paraview_<energy> (0: none; with --jobs 1)", lo=0),
 ], "out/single_impact", _KEEPING_ENERGIES, "energies", engine=("replace",),
-    check=lambda args: _check_specific_energies(args, "energies"))
+    check=lambda args: _check_specific_energies(args, "energies"),
+    materials=("material", "target"))
 
 REPEATED_IMPACT = laboratory_test(37.5e-3, [
     integer("particles", 100, "particles", lo=1),
@@ -295,7 +287,8 @@ REPEATED_IMPACT = laboratory_test(37.5e-3, [
    "impact", "impacts",
     overrides={"replace": Override(False, "the broken leave the test (the paper's Fig. 11): "
                                           "their fragments are not followed")},
-    check=lambda args: _check_specific_energies(args, "energy"))
+    check=lambda args: _check_specific_energies(args, "energy"),
+    materials=("material", "target"))
 
 DROP_WEIGHT = laboratory_test(5.5e-3, [
     integer("particles", 60, "particles tested at each energy", lo=1),
@@ -392,9 +385,35 @@ def read(job, description=None, argv=None):
     with its one line (exit code 2)."""
     declared = JOBS[job]
     args = script_params(declared.params(), description, argv, table_row=_table_row)
+    for option in declared.materials:
+        material_of(args, option)
     if declared.check is not None:
         declared.check(args)
     return args
+
+
+def material_of(args, option="material"):
+    """The Material that the material option `option` of a job's `args` names, loaded once, at
+    the job's edge (read(), or a job run from code), and kept in args.materials: the job and
+    its scenes take this object. A material that does not load, or a --material that does not
+    break, ends the program with one line (exit code 2) before anything is written."""
+    from yadebreak.criteria import load_material
+    from yadebreak.model.materials import MaterialError, available_materials
+    if not hasattr(args, "materials"):
+        args.materials = {}
+    if option not in args.materials:
+        value, flag = getattr(args, option), "--" + option.replace("_", "-")
+        try:
+            mat = load_material(value)
+        except MaterialError as exc:
+            where = "" if exc.source == str(value) else f"{exc.source}: "
+            fail(f"{flag} = {value}: {where}" + "; ".join(exc.problems))
+        if option == "material" and not mat.breakable:
+            breakable = [n for n in available_materials() if load_material(n).breakable]
+            fail(f"{flag} = {value}: not breakable (breakable = false in {mat.source}): accepted "
+                 f"a breakable material, e.g. {', '.join(breakable)}, or a .toml file")
+        args.materials[option] = mat
+    return args.materials[option]
 
 
 def _table_row(defaults):

@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from yadebreak.engine import add_materials, attach
-from yadebreak.engine.materials import rolling_friction
+from yadebreak.engine.materials import as_material, rolling_friction
 from yadebreak.adapter.yade_api import O, geom, utils
 from yadebreak.model.intervals import BALL_DIAMETER, BALL_MASS  # noqa: F401 (the paper's ball)
 from yadebreak.scenes.impacts import hertz_engines
@@ -134,14 +134,13 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
     if packing not in ("poured", "lattice") or (packing == "poured" and layers < 2):
         raise ValueError(f"packing {packing!r}: 'lattice', or 'poured' for beds of 2 layers or "
                          "more")
-    labels = {"ore": material, "steel": "steel"}
+    labels = {"ore": as_material(material), "steel": as_material("steel")}   # loaded once, here
     overrides = ({} if steel_rolling_friction is None
                  else {("ore", "steel"): float(steel_rolling_friction)})
     lattice = hex_bed_positions(size, rings, layers)
     holder_radius = float(np.max(np.linalg.norm(lattice[:, :2], axis=1)) + size / 2.0
                           + 0.02 * size)
 
-    mats = {"ore": _material(material), "steel": _material("steel")}   # (cache key, info)
     plan = _BedPlan(labels, overrides, lattice, holder_radius, packing, layers, size, seed,
                     settle_steps, stiffness_scale, rolling, say)
     if packing == "poured":
@@ -150,7 +149,7 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
                 sorted([list(k), v] for k, v in overrides.items()),
                 "holder_radius": holder_radius}
         folder = None if bed_cache is None else poured_bed.cache_folder(bed_cache)
-        bodies, settled = poured_bed.cached_scene(folder, poured_bed.cache_key(spec, mats),
+        bodies, settled = poured_bed.cached_scene(folder, poured_bed.cache_key(spec, labels),
                                                   lambda: _build_bed(plan))
     else:
         bodies, settled = _build_bed(plan)
@@ -161,9 +160,9 @@ def bed_impact_scene(material="copper_ore", size=5.5e-3, rings=3, layers=1, ener
                else np.array([tuple(O.bodies[i].state.pos) for i in particles]))
     top = max(O.bodies[i].state.pos[2] for i in particles) + size / 2.0
     ball_id, speed = _drop_ball(top, 0.02 * size, energy)
-    brk = attach({"ore": material}, seed=seed, **options)
+    brk = attach({"ore": labels["ore"]}, seed=seed, **options)
     info = {"anvil": bodies["anvil"], "particles": particles, "holder": bodies["holder"],
-            "ball": ball_id, "speed": speed, "centers": centers, "material": mats["ore"],
+            "ball": ball_id, "speed": speed, "centers": centers, "material": labels["ore"],
             "packing": packing, "rolling_friction": {
                 "particle_particle": named.get("ore-ore", 0.0),
                 "particle_steel": named.get("ore-steel", named.get("steel-ore", 0.0))},
@@ -177,11 +176,6 @@ def _holder(radius, height):
     return list(O.bodies.append(geom.facetCylinder((0, 0, height / 2.0), radius, height,
                                                    segmentsNumber=24, wallMask=4,
                                                    material="steel")))
-
-
-def _material(name):
-    from yadebreak.engine.materials import as_material
-    return as_material(name)
 
 
 def hold_release(info):

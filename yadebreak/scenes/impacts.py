@@ -12,6 +12,7 @@ import numpy as np
 # the coupling makes yade importable from Debian's python3 first
 from yadebreak.model import placement
 from yadebreak.engine import add_materials, attach, run_steps
+from yadebreak.engine.materials import as_material
 from yadebreak.engine.parts.rolling import install_rolling
 from yadebreak.engine.cells_replacement import body_kinetic_energy
 from yadebreak.scenes.polyhedra import volumetric_impact_scene
@@ -94,15 +95,16 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     until it ends (with workers: each scene's to `<log>.workers/<scene>.jsonl`, joined at the
     end; a failed run leaves them there). on_scene(scenes done, scenes, tally) after each scene
     (progress lines). A scene stops after max_steps at the latest (counted in
-    tally.scenes_at_step_limit). `material`: a name or path (workers get it as text). Returns
+    tally.scenes_at_step_limit). `material`, `target`: Materials, or names or paths (workers get
+    them as text, the file a Material was read from). Returns
     (reports.ImpactTally, with the steps of every scene; the last scene's controller, None with
     workers). wait_for_arrivals: see run_until_rebound. shape: "sphere" (impact_scene) or
     "polyhedra" (random convex polyhedra of sieve size `size` on YADE's volumetric law:
     scenes.polyhedra.volumetric_impact_scene). watch(scene, controller): a callable to call
     between checks of that scene's run and close() at its end, or None (in this process only:
     with workers it is not called)."""
-    spec = impact_spec(material, size, speed, particles, per_scene, seed, target, max_steps,
-                       wait_for_arrivals, shape, **options)
+    spec = impact_spec(_named(material), size, speed, particles, per_scene, seed, _named(target),
+                       max_steps, wait_for_arrivals, shape, **options)
     if pool is not None:
         return pool.collect(pool.submit(spec, event_log), on_scene), None
     workers = workers_for(jobs, spec["counts"])
@@ -112,7 +114,13 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
             return own.collect(own.submit(spec, event_log), on_scene), None
     if event_log is not None:
         Path(event_log).write_text("")
-    return run_scenes(spec, range(len(spec["counts"])), event_log, on_scene, watch)
+    return run_scenes(spec, range(len(spec["counts"])), event_log, on_scene, watch,
+                      (as_material(material), as_material(target)))
+
+
+def _named(material):
+    """A material as a worker process finds it: a name or path as given, a Material's file."""
+    return material if isinstance(material, str) else material.source
 
 
 #: the particle shapes of single impacts: the scene builder of each
@@ -152,22 +160,25 @@ def workers_for(jobs, counts):
     return min(jobs, len(counts)) if jobs > 1 and len(counts) > 1 else 0
 
 
-def run_scenes(spec, which, event_log=None, on_scene=None, watch=None):
+def run_scenes(spec, which, event_log=None, on_scene=None, watch=None, materials=None):
     """The scenes `which` of an impact_spec or drop_weight_spec, one after the other, their
     events appended to `event_log`: (tally, the last scene's controller). watch: see
-    single_impacts."""
+    single_impacts. materials: the (particles', target's) Materials when the caller has them;
+    None: those the spec names, loaded once here."""
     from yadebreak.analysis.reports import ImpactTally
     tally = ImpactTally(spec["size"])
     log = None if event_log is None else Path(event_log)
     live = None if log is None else log.with_suffix(".scene.jsonl")
     brk, counts = None, spec["counts"]
     drop_weight = spec.get("test") == "drop_weight"
+    material, target = materials or (as_material(spec["material"]),
+                                     as_material(spec.get("target", "steel")))
     for done, k in enumerate(which, start=1):
         began = time.perf_counter()
         seed, log_here = scene_seed(spec["seed"], k), None if live is None else str(live)
         if drop_weight:
             brk, ids, strikers = drop_weight_scene(
-                spec["material"], spec["size"], spec["specific_energy"], counts[k], seed=seed,
+                material, spec["size"], spec["specific_energy"], counts[k], seed=seed,
                 event_log=log_here, **spec["options"])
             initial_mass = brk.total_mass()
             with engine_time() as yade:
@@ -176,8 +187,8 @@ def run_scenes(spec, which, event_log=None, on_scene=None, watch=None):
         else:
             build = (volumetric_impact_scene if spec.get("shape") == "polyhedra"
                      else impact_scene)
-            brk, ids = build(spec["material"], spec["size"], [spec["speed"]] * counts[k],
-                             target=spec["target"], seed=seed, event_log=log_here,
+            brk, ids = build(material, spec["size"], [spec["speed"]] * counts[k],
+                             target=target, seed=seed, event_log=log_here,
                              **spec["options"])
             initial_mass = brk.total_mass()
             watcher = watch(k, brk) if watch is not None else None

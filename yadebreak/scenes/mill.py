@@ -97,9 +97,11 @@ def charge_counts(args):
 # -- the scene ----------------------------------------------------------------------------------------
 def mill_scene(args, options):
     """Build the mill, settle the charge with the drum still, attach yadebreak and start the drum.
-    Returns (controller, info)."""
+    Returns (controller, info). `args`: the job's (args.materials: the Materials its options
+    name, jobs.options.read)."""
     O.reset()
-    ip2, mats = engine.add_materials({"ore": args.material, "steel": "steel"},
+    ore_material = args.materials["material"]
+    ip2, mats = engine.add_materials({"ore": ore_material, "steel": "steel"},
                                        stiffness_scale=args.stiffness_scale)
     radius = 0.5 * args.drum_diameter
     profile = drum_profile(radius, args.lifters, args.lifter_height, args.lifter_width)
@@ -127,7 +129,7 @@ def mill_scene(args, options):
     for i in balls + ore:
         O.bodies[i].state.vel = (0, 0, 0)
         O.bodies[i].state.angVel = (0, 0, 0)
-    brk = engine.attach({"ore": args.material}, seed=args.seed, **options)
+    brk = engine.attach({"ore": ore_material}, seed=args.seed, **options)
     next(e for e in O.engines if isinstance(e, _w.RotationEngine)).angularVelocity = omega
     info = {"drum": list(drum), "ends": list(ends), "balls": balls, "ore": ore, "omega": omega, "speed_rps": speed,
             "start_time": O.time,                 # the settling's end: the mill's t = 0

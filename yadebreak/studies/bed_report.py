@@ -91,17 +91,19 @@ def psd_panel(ax, sel, label_of, title):
 
 
 def configurations(runs):
-    """A row per bed configuration (material, rings, layers, energy, steel rolling friction):
-    means and standard deviations over its runs (seeds)."""
+    """A row per bed configuration (material, rings, layers, energy, steel rolling friction,
+    outcome): means and standard deviations over its runs (seeds)."""
     groups = defaultdict(list)
     for r in runs:
-        groups[(r["material"], r["rings"], r["layers"], r["energy"], steel_rolling(r))].append(r)
+        groups[(r["material"], r["rings"], r["layers"], r["energy"], steel_rolling(r),
+                r.get("outcome", "paper"))].append(r)
     rows = []
-    for (mat, rings, layers, energy, crf), rs in sorted(groups.items()):
+    for (mat, rings, layers, energy, crf, outcome), rs in sorted(groups.items()):
         bm = np.array([r["broken_mass"] for r in rs]) * 1e3
         cr = np.array([r["capture_radius"] for r in rs]) * 1e3
         rows.append({"material": mat, "rings": rings, "layers": layers, "energy_J": energy,
                      "steel_rolling_friction": crf, "packing": rs[0].get("bed_packing", "lattice"),
+                     "outcome": outcome,
                      "runs": len(rs), "broken_mass_g": bm.mean(), "broken_mass_sd": bm.std(ddof=1)
                      if len(rs) > 1 else 0.0,
                      "broken_fraction": np.mean([r["broken_mass_fraction"] for r in rs]),
@@ -118,10 +120,11 @@ def write_tables(rows, out):
                            extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
-    lines = ["| material | rings | layers | packing | steel Crf | energy (J) | runs | broken mass (g) | "
-             "broken % | capture radius (mm) | run (s) |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| material | rings | layers | packing | steel Crf | energy (J) | outcome | runs | "
+             "broken mass (g) | broken % | capture radius (mm) | run (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     lines += [f"| {r['material']} | {r['rings']} | {r['layers']} | {r['packing']} | "
-              f"{r['steel_rolling_friction']:g} | {r['energy_J']:g} | {r['runs']} | "
+              f"{r['steel_rolling_friction']:g} | {r['energy_J']:g} | {r['outcome']} | {r['runs']} | "
               f"{r['broken_mass_g']:.3f} ± {r['broken_mass_sd']:.3f} | {100 * r['broken_fraction']:.1f} | "
               f"{r['capture_radius_mm']:.1f} ± {r['capture_radius_sd']:.1f} | {r['runtime_s']:.0f} |"
               for r in rows]

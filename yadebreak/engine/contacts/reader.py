@@ -21,7 +21,7 @@ import numpy as np
 from yadebreak.engine.contacts.arrays import ArrayRead
 from yadebreak.engine.contacts.each import read_each
 from yadebreak.engine.contacts.law import HertzMindlinWork, total_work
-from yadebreak.engine.contacts.volumetric import held_share, held_total
+from yadebreak.engine.contacts.volumetric import PairChecks, held_share, held_total
 from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OFFSETS, OVERLAP, SHARE_A,
                                              SHARE_B, SHARES, SHEAR_WORK, WORK, ContactTable,
                                              take)
@@ -44,6 +44,8 @@ class ContactReader:
         self.stiffness = stiffness_by_material_id     # YADE material id -> the stiffness of
         #                                               Eq. 4's shares (Pa; N/m3 on "volumetric")
         self.volumetric = law == "volumetric"
+        #: on the volumetric law: the checks YADE's silenced do_intersect warning counts
+        self.pair_checks = PairChecks() if self.volumetric else None
         self.last_time = None                         # O.time at the last read
         self.cs = cs
         self.emin = emin
@@ -67,6 +69,8 @@ class ContactReader:
         around the bodies whose count changed; `zeroing_changes`, the pairs that entered or left
         `zeroed` or `asleep` since the last read (None: unknown), spares it looking every row up
         in them again."""
+        if self.pair_checks is not None:
+            self.pair_checks.add(interactions, bodies)
         if self.volumetric or counts is None or len(self.table) <= self.small:
             loading = read_each(self, interactions.all(True), bodies, tracked, zeroed, now,
                                 interval, asleep,

@@ -77,6 +77,39 @@ def held_share(table, body, cs, emin):
     return total
 
 
+class PairChecks:
+    """What YADE's warning "Unhandled switch case:0, function do_intersect" would count. Its
+    Ig2_Polyhedra_Polyhedra_PolyhedraGeom tests each pair of polyhedra whose bounding boxes
+    overlap by do_intersect, from the separating plane kept in the pair's geometry; a pair with
+    none kept warns: a pair seen for the first time, and at every step a pair whose boxes
+    overlap without touching (a potential interaction has no geometry to keep one in).
+    Measured: two separated cubes whose boxes overlap, one warning a step; touching, one in
+    all. The engine silences that warning (adapter.yade_api.silence_polyhedra_pair_checks)
+    and counts here, at each read (every step on this law), the pairs that warned since the
+    last: those not touching, and those touching now that did not at the last read."""
+
+    def __init__(self):
+        self.count = 0
+        self.touching = set()
+        self._polyhedron = {}               # body id -> is a polyhedron (shapes do not change)
+
+    def add(self, interactions, bodies):
+        """Count the checks of this step from YADE's interactions, real and potential."""
+        polyhedron, touching, separated = self._polyhedron, set(), 0
+        for inter in interactions.all(False):
+            a, b = inter.id1, inter.id2
+            for i in (a, b):
+                if i not in polyhedron:
+                    polyhedron[i] = type(bodies[i].shape).__name__ == "Polyhedra"
+            if polyhedron[a] and polyhedron[b]:
+                if inter.isReal:
+                    touching.add((a, b))
+                else:
+                    separated += 1
+        self.count += separated + len(touching - self.touching)
+        self.touching = touching
+
+
 def held_total(table, body):
     """Elastic energy (J) a body's volumetric contacts hold, both sides."""
     return sum(max(table.value(row, HELD), 0.0) for row, _ in table.rows_of(body))

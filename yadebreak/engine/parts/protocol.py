@@ -27,6 +27,7 @@ calls `run(kind, label)`: they keep running as they were saved.
 from __future__ import annotations
 
 import json
+from importlib import import_module
 
 from yadebreak.adapter.yade_api import O, current_scene, find_engine, wrapper
 
@@ -36,7 +37,13 @@ AFTER_INTERACTIONS = "after_interactions"
 AFTER_NEWTON = "after_newton"
 HOOKS = (BEFORE_INTERACTIONS, AFTER_INTERACTIONS, AFTER_NEWTON)
 
-_KINDS: dict[str, type] = {}              # kind -> Part subclass
+_KINDS: dict[str, type] = {}              # kind -> Part subclass (those defined so far)
+#: the package's parts: kind -> the module that defines it, imported when a loaded scene names
+#: the kind (no import is needed first for its side effect); a part defined elsewhere is found
+#: by the module saved with its state (`part_module`)
+PART_MODULES = {"breakage": "yadebreak.engine.scene", "breakage_zero": "yadebreak.engine.scene",
+                "rolling": "yadebreak.engine.parts.rolling",
+                "bonds": "yadebreak.engine.parts.bonds"}
 _LIVE: dict[str, "Part"] = {}             # label -> this process's part
 _SCENE_OF: dict[str, object] = {}         # label -> the scene its part belongs to
 _MEMBERS: dict[str, tuple] = {}           # hook -> (scene, [(kind, label), ...]) read from O.tags
@@ -179,7 +186,22 @@ def hold(part):
 
 def save_state(part, folder=None):
     O.tags[part.tag] = json.dumps({**part.to_state(folder), "period": part.period,
-                                   "last": part.last, "awake": part.awake})
+                                   "last": part.last, "awake": part.awake,
+                                   "part_module": type(part).__module__})
+
+
+def part_class(kind, module=None):
+    """The Part subclass of `kind`, its module imported if no class of that kind is defined in
+    this process yet: `module` (the one saved with the part), else PART_MODULES'."""
+    if kind not in _KINDS:
+        where = module or PART_MODULES.get(kind)
+        if where is None:
+            raise RuntimeError(f"no yadebreak part of kind {kind!r} is defined: import the "
+                               "module that defines it before loading the scene")
+        import_module(where)
+        if kind not in _KINDS:
+            raise RuntimeError(f"module {where} defines no yadebreak part of kind {kind!r}")
+    return _KINDS[kind]
 
 
 def live(kind):
@@ -256,7 +278,7 @@ def _named(label):
 
 def runs(kind, label):
     """How many times the runner of part `label` has run (YADE's nDone; 0 if none)."""
-    runner = find_engine(label) or find_engine(runner_label(_KINDS[kind].hook))
+    runner = find_engine(label) or find_engine(runner_label(part_class(kind).hook))
     return getattr(runner, "nDone", 0)
 
 
@@ -284,10 +306,13 @@ def part_of(kind, label):
     holds none that followed this scene (after O.load, or a part of an earlier scene)."""
     part = _LIVE.get(label)
     if part is None or _SCENE_OF[label] != current_scene() or not part.current():
-        cls = _KINDS[kind]
-        tag = cls.tag_for(label)
-        data = (json.loads(O.tags[tag]) if tag in O.tags.keys() and O.tags[tag]
-                else cls.legacy_state(label))
+        cls = _KINDS.get(kind)
+        if cls is None and kind not in PART_MODULES:     # its module, named in its state
+            cls = part_class(kind, _saved(f"yadebreak_{kind}:{label}", {}).get("part_module"))
+        cls = cls or part_class(kind)
+        data = _saved(cls.tag_for(label), None)
+        if data is None:
+            data = cls.legacy_state(label)
         if data is None:
             raise RuntimeError(f"the scene has no state of yadebreak's {kind} part {label!r}: "
                                "save scenes with yadebreak.save or a job's checkpoint")
@@ -297,6 +322,11 @@ def part_of(kind, label):
         part.last, part.awake = data.get("last"), data.get("awake", True)
         hold(part)
     return part
+
+
+def _saved(tag, default):
+    """The state stored under O.tags[tag], or `default`."""
+    return json.loads(O.tags[tag]) if tag in O.tags.keys() and O.tags[tag] else default
 
 
 def _members(hook):

@@ -1,0 +1,44 @@
+"""A material is resolved once, at the edge (a job's options, attach()), then passed on as an
+object: a run reads each material file once, and a material that cannot serve is refused in one
+line before anything is written."""
+import pytest
+
+from yadebreak.jobs import options as job_options
+from yadebreak.model import materials
+
+
+def _read(tmp_path, capsys, *argv):
+    with pytest.raises(SystemExit) as ended:
+        job_options.read("single_impact", argv=[*argv, "--out", str(tmp_path / "out")])
+    assert ended.value.code == 2
+    return capsys.readouterr().err.strip().splitlines()
+
+
+def test_a_material_that_cannot_serve_is_refused_before_anything_is_written(tmp_path, capsys):
+    lines = _read(tmp_path, capsys, "--material", "steel")
+    assert len(lines) == 1 and lines[0].startswith("[yadebreak] error: --material = steel: not "
+                                                   "breakable (breakable = false in ")
+    assert "copper_ore" in lines[0]
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "bad"\nbreakable = true\n')
+    lines = _read(tmp_path, capsys, "--material", str(bad))
+    assert len(lines) == 1 and f"--material = {bad}: elastic: missing table [elastic]" in lines[0]
+    lines = _read(tmp_path, capsys, "--target", "nosuch")
+    assert len(lines) == 1 and "--target = nosuch: unknown material 'nosuch'" in lines[0]
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.yade
+def test_a_run_reads_each_material_file_once(tmp_path, monkeypatch, scene):
+    """Two energies of single impacts, two scenes each: the particles' and the target's files are
+    read once each, by the job's options; scenes and attach() take the objects."""
+    from yadebreak.jobs import impacts
+    read = []
+    parse = materials.parse
+    monkeypatch.setattr(materials, "parse", lambda doc, source, criteria: (
+        read.append(str(source)), parse(doc, source, criteria))[1])
+    args = job_options.read("single_impact", argv=[
+        "--material", "granulite", "--target", "rubber", "--size", "4mm", "--particles", "2",
+        "--energies", "50,80", "--out", str(tmp_path / "out")])
+    impacts.single(args)
+    assert sorted(p.rsplit("/", 1)[-1] for p in read) == ["granulite.toml", "rubber.toml"]
