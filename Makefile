@@ -24,6 +24,8 @@ deps:
 # A one-line yadebreak.pth naming this checkout, in the site folder of /usr/bin/python3 that pip
 # would use (/usr/local/lib/python3.X/dist-packages as root, the user's own site folder otherwise):
 # no pip, no network, no build files in the checkout; rewritten only when it names another folder.
+# And the `yadebreak` command (/usr/local/bin as root, ~/.local/bin otherwise): /usr/bin/python3
+# -m yadebreak, whichever python3 (pyenv, conda) comes first on PATH.
 define LINK_PACKAGE
 import os, site, sys
 folder = site.getsitepackages()[0] if os.geteuid() == 0 else site.getusersitepackages()
@@ -33,6 +35,18 @@ if not os.path.exists(path) or open(path).read() != line:
     with open(path, "w") as f:
         f.write(line)
     print(f"[yadebreak] wrote {path}: import yadebreak now works from any folder")
+folder = "/usr/local/bin" if os.geteuid() == 0 else os.path.expanduser("~/.local/bin")
+path = os.path.join(folder, "yadebreak")
+text = ("#!/bin/sh\n# written by yadebreak's make deps: Debian's python3, whichever comes first "
+        "on PATH\nexec /usr/bin/python3 -m yadebreak \"$$@\"\n")
+if not os.path.exists(path) or open(path).read() != text:
+    os.makedirs(folder, exist_ok=True)
+    with open(path, "w") as f:
+        f.write(text)
+    os.chmod(path, 0o755)
+    on_path = folder in os.environ.get("PATH", "").split(os.pathsep)
+    print(f"[yadebreak] wrote {path}: the yadebreak command"
+          + ("" if on_path else f" (add {folder} to PATH)"))
 endef
 export LINK_PACKAGE
 

@@ -153,6 +153,8 @@ def _unchanged(O):
 @pytest.mark.parametrize("event_log, shown", [
     ("{tmp}", r"event_log = '.*': a folder; accepted: a file path"),
     ("{tmp}/ro/events.jsonl", r"event_log = '.*/ro/events.jsonl': cannot be written here"),
+    ("/proc/yadebreak_events.jsonl", r"event_log = '/proc/yadebreak_events.jsonl': cannot be "
+                                     r"written \("),
 ])
 def test_a_bad_event_log_is_refused_before_the_scene_changes(scene, tmp_path, event_log, shown):
     import os
@@ -167,6 +169,8 @@ def test_a_bad_event_log_is_refused_before_the_scene_changes(scene, tmp_path, ev
                              capture_output=True).returncode == 0
     if "ro" in event_log and not mounted and os.access(ro, os.W_OK):
         pytest.skip("no read-only folder can be made here")
+    import yadebreak
+    assert yadebreak.AttachError is engine.AttachError          # the README's name for it
     try:
         with pytest.raises(engine.AttachError, match=shown):
             engine.attach({"ore": "copper_ore"}, event_log=event_log.format(tmp=tmp_path))

@@ -29,3 +29,17 @@ def test_extreme_case_is_finite_conservative_and_ends(scene, name):
     assert r["ended"], r
     assert r["max_breakages_one_step"] >= case.expect.get("min_breakages_one_step", 0), r
     assert r["ok"]
+
+
+def test_a_case_filter_that_matches_nothing_is_refused_in_one_line(tmp_path, capsys):
+    """--only naming no case: one line with the cases' names, exit 2, nothing written."""
+    import argparse
+    from yadebreak.jobs import extremes
+    args = argparse.Namespace(only="nosuchcase", fast=True, out=str(tmp_path / "out"))
+    with pytest.raises(SystemExit) as ended:
+        extremes.run(args)
+    assert ended.value.code == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("[yadebreak] error: --only = nosuchcase: no "
+                                                   "case's name holds it; the cases: ")
+    assert "Ab-T10, S x 1e-3" in lines[0] and not (tmp_path / "out").exists()

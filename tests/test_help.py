@@ -52,3 +52,19 @@ def test_help_of_the_module_and_of_tradeoff_and_gather_sweep_as_run():
     said = subprocess.run([PYTHON, "-m", "yadebreak", "tradeoff", "--help"], capture_output=True,
                           text=True, timeout=120, cwd=ROOT).stdout
     assert "with a 95 %\ninterval" in said                 # its usage's % as written
+
+
+def test_the_yadebreak_command_runs_debians_python_whichever_comes_first(tmp_path):
+    """make deps installs `yadebreak` (as root /usr/local/bin, else ~/.local/bin): it runs
+    /usr/bin/python3 -m yadebreak even where another python3 comes first on PATH."""
+    import os
+    import shutil
+    command = shutil.which("yadebreak") or os.path.expanduser("~/.local/bin/yadebreak")
+    assert os.access(command, os.X_OK), "make deps writes the yadebreak command"
+    fake = tmp_path / "python3"
+    fake.write_text("#!/bin/sh\necho 'No module named yadebreak' >&2\nexit 1\n")
+    fake.chmod(0o755)
+    env = {**os.environ, "PATH": f"{tmp_path}{os.pathsep}{os.environ.get('PATH', '')}"}
+    said = subprocess.run([command, "materials"], capture_output=True, text=True, env=env,
+                          timeout=120)
+    assert said.returncode == 0 and "copper_ore" in said.stdout, said.stderr

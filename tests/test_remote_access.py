@@ -108,3 +108,27 @@ def test_a_pool_worker_closes_them_too(tmp_path):
         except OSError:                      # no reader: it never got there
             proc.kill()
         proc.wait(60)
+
+
+def test_attach_closes_them_in_a_users_own_scene_and_says_so_once(tmp_path):
+    """A user's scene under the `yade` launcher: once attach() returns nothing listens on a
+    non-loopback address (nothing at all: both servers are closed), and one line says so;
+    attach(remote_access=True) keeps them."""
+    for keep, expected in ((False, 0), (True, 2)):
+        script = tmp_path / f"scene_{keep}.py"
+        script.write_text(
+            f"import sys, time\nsys.path.insert(0, {str(ROOT)!r})\n"
+            "from yade import O, utils\nimport yadebreak\nfrom yadebreak import scenes\n"
+            "from yadebreak.engine import add_materials\n"
+            "ip2, _ = add_materials({'ore': 'copper_ore'})\n"
+            "O.bodies.append(utils.sphere((0, 0, 0), 1e-3, material='ore'))\n"
+            "O.engines = scenes.hertz_engines(ip2)\n"
+            f"yadebreak.attach({{'ore': 'copper_ore'}}, remote_access={keep})\n"
+            "print('attached', flush=True)\ntime.sleep(60)\n")
+        proc, lines = _started(["yade", "-n", "-x", str(script)], tmp_path, "attached")
+        try:
+            assert len(listening_ports(proc.pid)) == expected, "".join(lines)
+            said = [line for line in lines if "closed YADE's remote" in line]
+            assert len(said) == (0 if keep else 1), "".join(lines)
+        finally:
+            _stop(proc)

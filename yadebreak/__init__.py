@@ -26,6 +26,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 from yadebreak.model.materials import (Material, MaterialError, available_materials,
                                        material_search_path)
 from yadebreak.criteria import load_material
+from yadebreak.options.table import AttachError
 from yadebreak import model
 from yadebreak import criteria
 from yadebreak._moved import install as _install_moved
@@ -34,7 +35,7 @@ _install_moved()
 
 __version__ = "0.3.0"
 
-__all__ = ["Material", "MaterialError", "available_materials", "load_material",
+__all__ = ["AttachError", "Material", "MaterialError", "available_materials", "load_material",
            "material_search_path", "model", "criteria", "attach", "save"]
 
 # where the modules of version 0.2 went: `from yadebreak import families` keeps working

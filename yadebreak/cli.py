@@ -1,4 +1,4 @@
-"""Command line: `python -m yadebreak demo | families | materials | options | sweep | gather |
+"""Command line: `yadebreak demo | families | materials | options | sweep | gather |
 tradeoff | fit | grind | verify` (no YADE needed here but for verify, which runs YADE in its
 process; the workers of a sweep or a trade-off run YADE).
 
@@ -139,7 +139,7 @@ def gather(args):
     print(f"[yadebreak] wrote {path}")
 
 
-TRADEOFF_USAGE = """python -m yadebreak tradeoff SCRIPT [script options] --vary NAME=V1,V2,...
+TRADEOFF_USAGE = """yadebreak tradeoff SCRIPT [script options] --vary NAME=V1,V2,...
     [--vary ...] --seeds N --metrics KEY,KEY,... --out DIR [--reference NAME=V,...]
     [--scheduler SPEC] [--retries N]
 
@@ -153,10 +153,10 @@ follow SCRIPT and reach every run."""
 
 
 def tradeoff_command(argv):
-    """`python -m yadebreak tradeoff`: its own parser, as the script's options pass through."""
+    """`yadebreak tradeoff`: its own parser, as the script's options pass through."""
     from yadebreak.studies import tradeoff as to
     from yadebreak.studies.sweep import SweepError
-    parser = ScriptParser(prog="python -m yadebreak tradeoff", usage=TRADEOFF_USAGE,
+    parser = ScriptParser(prog="yadebreak tradeoff", usage=TRADEOFF_USAGE,
                           allow_abbrev=False)
     parser.add_argument("script", help="the YADE script (takes --seed, --out and the options)")
     parser.add_argument("--vary", action="append", default=[], help="NAME=V1,V2,... (repeatable)")
@@ -320,14 +320,14 @@ def main(argv=None):
             if _value_of(argv, "--debug", "0") not in ("1", "true", "yes", "on"):
                 environment_error(exc, _value_of(argv[1:], "--out", out), began)
             raise
-    parser = ScriptParser(prog="python -m yadebreak")
+    parser = ScriptParser(prog="yadebreak")
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("tradeoff", help="speed against accuracy of a script's options, over seeds "
-                   "(python -m yadebreak tradeoff --help)")     # parsed by tradeoff_command
+                   "(yadebreak tradeoff --help)")     # parsed by tradeoff_command
     sub.add_parser("fit", help="a material file from laboratory data, with 95 %% intervals "
-                   "(python -m yadebreak fit --help; docs/calibration.md)")
+                   "(yadebreak fit --help; docs/calibration.md)")
     sub.add_parser("verify", help="the paper's Section 4.1 figures at its settings, a report "
-                   "with plots (python -m yadebreak verify --help; --quick 1: under 3 minutes)")
+                   "with plots (yadebreak verify --help; --quick 1: under 3 minutes)")
     for name, command in COMMANDS.items():
         p = sub.add_parser(name, help=command.help, description=command.help)
         for arg, arg_help in command.positional:

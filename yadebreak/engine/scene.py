@@ -7,11 +7,13 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from pathlib import Path
 
 from yadebreak.model.materials import MATERIALS_DIR
 from yadebreak.engine.parts import protocol
-from yadebreak.adapter.yade_api import O, find_engine, scene_folder, wrapper
+from yadebreak.adapter.yade_api import (O, close_remote_access, find_engine, scene_folder,
+                                        wrapper)
 from yadebreak.options.table import AttachError, Config
 from yadebreak.engine.controller import Controller
 from yadebreak.engine.materials import breakable_spheres, check_mapping, dummy_materials, resolve
@@ -103,6 +105,8 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
         raise AttachError(f"yadebreak is already attached to this scene as '{label}': call attach "
                           "once per scene (or give another label)")
     engines = list(O.engines)
+    if not config.output.remote_access:
+        _close_remote_access()
     loop_idx, law = contact_law(engines)
     if law == "volumetric" and config.reading.cs > 0.0:
         raise AttachError(f"cs = {config.reading.cs:g}: the volumetric law's shear work is not "
@@ -176,6 +180,16 @@ def _check_event_log(path):
             target.exists() and not os.access(target, os.W_OK)):
         raise AttachError(f"event_log = {path!r}: cannot be written here ({folder} is not a "
                           "writable folder); accepted: a writable file path or None")
+    if folder == target.parent:                # opened as the log will be (root passes access()
+        existed = target.exists()              # where a file system refuses: /proc, read-only)
+        try:
+            with open(target, "a"):
+                pass
+        except OSError as exc:
+            raise AttachError(f"event_log = {path!r}: cannot be written ({exc.strerror}); "
+                              "accepted: a writable file path or None") from None
+        if not existed:
+            target.unlink()
 
 
 def _check_not_tracked_elsewhere(label, ids):
@@ -237,6 +251,16 @@ def _state(ctl, folder=None):
         "state": ctl.state.to_dict(),
         "contacts": ctl.reader.to_dict(), "zeroed": ctl.zeroing.to_list(),
         "damped_until": ctl.damping.until, "fast": ctl.schedule.to_list()}
+
+
+def _close_remote_access():
+    """Close the `yade` launcher's remote prompt and XMLRPC server (they listen on every
+    interface), saying so once, when there are any (a script closed them already)."""
+    ports = close_remote_access()
+    if ports:
+        print(f"[yadebreak] closed YADE's remote Python prompt and XMLRPC server (ports "
+              f"{', '.join(map(str, ports))}), which listen on every interface: "
+              "attach(remote_access=True) keeps them", file=sys.stderr, flush=True)
 
 
 def _material_reference(material):

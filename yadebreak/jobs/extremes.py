@@ -23,6 +23,7 @@ from yadebreak.engine import attach
 from yadebreak.scenes import extremes as extreme_scenes, view
 from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import mark_finished, progress
+from yadebreak.options.flags import fail
 
 SIZE = 5.5e-3
 
@@ -189,13 +190,15 @@ def run(args):
     counts): a table on stdout, and extremes.md, extremes.csv and extremes.json in args.out.
     Returns the exit status: 1 if any case fails. No checkpoints or --resume: a case takes
     seconds and the matrix is run whole."""
+    chosen = [case for case in cases() if not args.only or args.only in case.name]
+    if not chosen:
+        fail(f"--only = {args.only}: no case's name holds it; the cases: "
+             + "; ".join(case.name for case in cases()))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     start = time.time()
-    for case in cases():
-        if args.only and args.only not in case.name:
-            continue
+    for case in chosen:
         r = run_case(case, fast=args.fast)
         rows.append(r)
         progress(f"{case.name}: {'ok' if r['ok'] else 'FAILED'}, {r['breakages']} breakages, "

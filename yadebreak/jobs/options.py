@@ -359,7 +359,7 @@ before anything changes in the scene: a bad value raises `AttachError` naming th
 value, the accepted range and the unit. The scripts' flags of these options (`--read-period` for
 `read_period`) are made from the same table, with the same defaults but for the overrides listed
 below; on a command line None is written as the word or number the flag's `--help` names
-(`--global-damping material`, `--dmin 0`). Written by `python3 -m yadebreak options` from
+(`--global-damping material`, `--dmin 0`). Written by `yadebreak options` from
 `yadebreak/options/table.py`, `yadebreak/jobs/options.py` and the verify command's settings
 (`yadebreak/studies/verify`); a test keeps this page the same as its sources.
 

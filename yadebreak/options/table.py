@@ -239,7 +239,12 @@ OPTIONS = (
          none="for as long as they exist", token="forever"),
     # output
     _row("event_log", "output", None, "path", "-",
-         "JSON-lines file that receives every event as it happens", none="no file"),
+         "JSON-lines file that receives every event as it happens (missing folders are made)",
+         none="no file"),
+    _row("remote_access", "output", False, "boolean", "-",
+         "keep the remote Python prompt and XMLRPC server that the `yade` launcher opens on "
+         "every interface (ports 9000 and 21000 or up); False: attach() closes them and says so "
+         "once"),
 )
 
 _BY_NAME = {o.name: o for o in OPTIONS}
@@ -293,6 +298,7 @@ class TimeStep:
 @dataclass(frozen=True)
 class Output:
     event_log: str | None
+    remote_access: bool
 
 
 _GROUPS = {"reading": Reading, "criteria": Criteria, "replacement": Replacement,

@@ -21,7 +21,7 @@ from yadebreak.studies.calibration.fit import apply_bootstrap, bootstrap, fit_al
 from yadebreak.studies.calibration.mle import FitError
 
 def parser():
-    p = ScriptParser(prog="python3 -m yadebreak fit", description=(
+    p = ScriptParser(prog="yadebreak fit", description=(
         "Fit a material to laboratory data (CSV files; the kind of each is told from its "
         "columns: docs/calibration.md)."))
     p.add_argument("data", nargs="+", help="CSV files: fracture energies, t10, repeated impacts, "

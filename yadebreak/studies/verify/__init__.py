@@ -200,7 +200,7 @@ def verify(args):
 def main(argv):
     """Parse `argv` (after `verify`) and run; bad values stop with one line (exit 2)."""
     from yadebreak.options.flags import DEBUG, ScriptParser, add_params, read_params
-    parser = ScriptParser(prog="python3 -m yadebreak verify", description=__doc__.split("\n")[0])
+    parser = ScriptParser(prog="yadebreak verify", description=__doc__.split("\n")[0])
     add_params(parser, PARAMS + [DEBUG])
     args = read_params(parser.parse_args(argv), PARAMS + [DEBUG])
     args.argv = list(argv)
