@@ -262,8 +262,8 @@ def test_a_damaged_checkpoint_is_refused_in_one_line(scene, tmp_path):
     from yadebreak.jobs import agglomerate
     from yadebreak.jobs.lifecycle import ScriptError
     (tmp_path / "checkpoint.yade.gz").write_bytes(b"\x1f\x8b\x08garbage")
-    with pytest.raises(ScriptError, match=r"checkpoint.yade.gz is damaged .*run again without "
-                                          r"--resume$"):
+    with pytest.raises(ScriptError, match=r"checkpoint.yade.gz is damaged .*start the run over "
+                                          r"with --overwrite 1, or choose another --out$"):
         agglomerate.run(_args(tmp_path, resume=True), quiet=True)
     assert not (tmp_path / "summary.json").exists()
 

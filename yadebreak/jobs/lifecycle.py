@@ -228,8 +228,9 @@ def claim_out(out, args, found):
                           "or start it over)")
     if resume or found is None:
         return
-    if not overwrite:
-        ways = "continue it with --resume 1, start" if hasattr(args, "resume") else "start"
+    if not overwrite:               # each way named works (a finished run does not resume)
+        ways = ("continue it with --resume 1, start" if hasattr(args, "resume")
+                and found.startswith("an interrupted run") else "start")
         raise ScriptError(f"--out = {out} holds {found}: {ways} it over with --overwrite 1, or "
                           "choose another --out")
     for name in (FINISHED, CHECKPOINT, PARTIAL):
@@ -239,6 +240,9 @@ def claim_out(out, args, found):
 # -- what a run leaves -----------------------------------------------------------------------------
 CHECKPOINT = "checkpoint.yade.gz"
 PARTIAL = "partial.json"
+#: the way on from what --resume 1 cannot continue (a plain run would be refused: the folder
+#: holds a run)
+AGAIN = "it cannot be resumed; start the run over with --overwrite 1, or choose another --out"
 
 
 def kept_outputs(out, since):
@@ -288,7 +292,7 @@ def read_checkpoint(path, load):
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"--resume: no checkpoint at {path}; run without --resume first")
-    again = "it cannot be resumed; run again without --resume"
+    again = AGAIN
     try:
         if path.stat().st_size == 0:
             raise ValueError("the file is empty")
@@ -426,7 +430,7 @@ def check_not_finished(out, args):
     if path.exists():
         check_resume_arguments(json.loads(path.read_text())["arguments"], args, path)
         raise RunFinished(f"the run in {out} had finished: nothing to resume, its outputs are "
-                          "kept (run again without --resume to redo it)")
+                          "kept (--overwrite 1 runs it again)")
 
 
 def stop_if_asked(args, units_done):
@@ -475,19 +479,18 @@ class PartialResults:
                 raise ValueError("'arguments' and 'done' must be objects")
         except (ValueError, KeyError, TypeError) as exc:     # UnicodeDecodeError is a ValueError
             raise ScriptError(f"{refuse} is damaged ({type(exc).__name__}: {first_line(exc)}): "
-                              "it cannot be resumed; run again without --resume") from None
+                              f"{AGAIN}") from None
         check_resume_arguments(arguments, self.args, self.path)
         if "digest" in data and data["digest"] != _digest(done):
             raise ScriptError(f"{refuse} was changed after it was written (its digest does not "
-                              "match): it cannot be resumed; run again without --resume")
+                              f"match): {AGAIN}")
         for key, result in done.items():
             try:
                 if validate is not None:
                     validate(key, result)
             except (ValueError, KeyError, TypeError) as exc:
                 raise ScriptError(f"{refuse}: the result for {key} is not one this run could "
-                                  f"have written ({first_line(exc)}); run again without "
-                                  "--resume") from None
+                                  f"have written ({first_line(exc)}): {AGAIN}") from None
         return done
 
     def todo(self, keys):

@@ -4,8 +4,9 @@ skeleton does the rest, the same way for all.
 A scene that runs in chunks of steps (bed, mill, agglomerate) is a `Job`; `run(job)` then:
 starts it (a fresh run: finish marker removed, then job.build(); --resume 1: a finished run says
 so and stops, otherwise the checkpoint is read, damaged ones refused in one line, and its
-arguments checked against this run's, then job.resume()); calls job.advance() until it says how
-the run ended, writing a checkpoint every --checkpoint-every s of wall time and stopping at
+arguments checked against this run's, then job.resume(); a run that left no checkpoint starts
+again); calls job.advance() until it says how the run ended, writing a checkpoint at the first
+safe point and then every --checkpoint-every s of wall time and stopping at
 SIGINT or SIGTERM (checkpointed) at the job's safe points; ends as if killed at --stop-after
 (tests); prints a progress line with the time left every job.report_every s; on a failure
 writes the outputs so far with their end reason; at the end writes the outputs, the finish
@@ -24,6 +25,7 @@ Jobs of independent units (the energies of single impacts and drop-weight tests)
 `run_units`, which keeps each finished unit in <out>/partial.json (PartialResults): --resume 1
 skips them.
 """
+import math
 import time
 from pathlib import Path
 
@@ -158,7 +160,10 @@ def _start(job):
     """Build the scene, or resume it (--resume 1); the wall time (s) of earlier invocations."""
     if getattr(job.args, "resume", False):
         check_not_finished(job.out, job.args)     # a finished run: says so, nothing is rewritten
-        return job.resume(job.out / CHECKPOINT)
+        if (job.out / CHECKPOINT).exists():
+            return job.resume(job.out / CHECKPOINT)
+        progress(f"--resume: {job.out} holds no checkpoint (the run stopped before its first): "
+                 "it starts again, with the same options and seed")
     mark_started(job.out)
     (job.out / CHECKPOINT).unlink(missing_ok=True)   # an earlier run's: --resume must not find it
     job.build()
@@ -171,7 +176,9 @@ def _loop(job, start, runtime):
     args, path = job.args, job.out / CHECKPOINT
     every = getattr(args, "checkpoint_every", job.checkpoint_every)
     stop_after = getattr(args, "stop_after", 0.0)
-    last_report = last_checkpoint = start
+    last_report = start
+    last_checkpoint = -math.inf           # the first at the first safe point: seconds in, a run
+    #                                       killed early goes on from there
 
     def save():
         job.save(path, runtime())

@@ -326,8 +326,10 @@ def checkpointed_run_options(vtk_interval, out):
     return [
         number("vtk_interval", vtk_interval, "s", "simulated time between frames of the ParaView "
                "series in <out>/paraview (0: no series)", lo=0),
-        number("checkpoint_every", 60.0, "s", "wall time between checkpoints (< 0: none)"),
-        flag("resume", False, "continue the run that died in --out from its checkpoint"),
+        number("checkpoint_every", 60.0, "s", "wall time between checkpoints, the first a few "
+               "seconds in (< 0: none)"),
+        flag("resume", False, "continue the run that died in --out from its checkpoint (none: "
+             "it starts again)"),
         overwrite_option(),
         number("stop_after", 0.0, "s", "(tests) end as if killed at this simulated time "
                "(0: never)", lo=0),
