@@ -1,6 +1,6 @@
-"""A material is resolved once, at the edge (a job's options, attach()), then passed on as an
-object: a run reads each material file once, and a material that cannot serve is refused in one
-line before anything is written."""
+"""A job's edge: a material is resolved once (a job's options, attach()), then passed on as an
+object, so a run reads each material file once; a material that cannot serve, or a bed too large
+to build, is refused in one line before anything is written."""
 import pytest
 
 from yadebreak.jobs import options as job_options
@@ -42,3 +42,24 @@ def test_a_run_reads_each_material_file_once(tmp_path, monkeypatch, scene):
         "--energies", "50,80", "--out", str(tmp_path / "out")])
     impacts.single(args)
     assert sorted(p.rsplit("/", 1)[-1] for p in read) == ["granulite.toml", "rubber.toml"]
+
+
+@pytest.mark.parametrize("layers", [1, 5])
+def test_a_bed_past_the_largest_is_refused_with_its_count_and_memory(tmp_path, capsys, layers):
+    """--rings past MOST_BED_PARTICLES: one line with the count, the memory and the largest
+    --rings accepted, which is accepted and the next refused."""
+    def read(rings):
+        return job_options.read("bed_impact", argv=["--rings", str(rings), "--layers",
+                                                     str(layers), "--out", str(tmp_path / "o")])
+    with pytest.raises(SystemExit) as ended:
+        read(3000)
+    assert ended.value.code == 2
+    line = capsys.readouterr().err.strip()
+    count = layers * (1 + 3 * 3000 * 3001)
+    assert line.startswith(f"[yadebreak] error: --rings = 3000 with --layers = {layers}: "
+                           f"{count:,} particles (about ")
+    largest = int(line.rsplit("--rings <= ", 1)[1].split()[0])
+    assert read(largest).rings == largest
+    with pytest.raises(SystemExit):
+        read(largest + 1)
+    assert not (tmp_path / "o").exists()
