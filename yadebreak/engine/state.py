@@ -226,8 +226,11 @@ class EventLog:
         """Make the file hold exactly the events in memory (after a restore)."""
         if self.path is not None:
             tmp = self.path.with_suffix(".tmp")
-            tmp.write_text("".join(json.dumps(e) + "\n" for e in self.events))
-            tmp.replace(self.path)
+            try:
+                tmp.write_text("".join(json.dumps(e) + "\n" for e in self.events))
+                tmp.replace(self.path)
+            finally:                                # a full disk leaves no half file
+                tmp.unlink(missing_ok=True)
 
     def record(self, event):
         self.events.append(event)
