@@ -14,8 +14,8 @@ from yadebreak.model.materials import MaterialError
 from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import write_atomic
 from yadebreak.jobs.lifecycle import tool_run
-from yadebreak.options.flags import (ScriptParser, add_params, fail, out_option, overwrite_option,
-                                     read_params)
+from yadebreak.options.flags import (DEBUG, ScriptParser, add_params, fail, out_option,
+                                     overwrite_option, read_params)
 from yadebreak.studies.calibration import data, outputs
 from yadebreak.studies.calibration.fit import apply_bootstrap, bootstrap, fit_all
 from yadebreak.studies.calibration.mle import FitError
@@ -35,8 +35,7 @@ def parser():
     p.add_argument("--bootstrap", default="0", help="bootstrap replicates for the intervals "
                    "(0: profile likelihood; default 0)")
     p.add_argument("--seed", default="1", help="seed of the bootstrap resampling (default 1)")
-    p.add_argument("--debug", default="0", help="1: tracebacks instead of one-line errors")
-    add_params(p, [overwrite_option()])
+    add_params(p, [overwrite_option(), DEBUG])
     return p
 
 
@@ -48,7 +47,7 @@ def _whole(text, option, lo):
 
 def main(argv=None):
     args = parser().parse_args(sys.argv[1:] if argv is None else argv)
-    read_params(args, [out_option(None), overwrite_option()])
+    read_params(args, [out_option(None), overwrite_option(), DEBUG])
     replicates = _whole(args.bootstrap, "bootstrap", 0)
     seed = _whole(args.seed, "seed", 0)
     if not args.name.replace("_", "").replace("-", "").isalnum():
@@ -57,7 +56,7 @@ def main(argv=None):
         with tool_run(args.out, args):
             return run(args, replicates, seed)
     except (data.DataError, FitError, MaterialError) as exc:
-        if args.debug == "1":
+        if args.debug:
             raise
         fail(str(exc).replace("\n", " "))
 
