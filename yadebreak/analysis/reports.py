@@ -352,7 +352,10 @@ def plot_breakage(results, material, size, partner, title, path, label="simulati
                          c=f"C{k}", label=f"simulation, t10 {r['t10_simulated']:.1f} %")
     axes[2].set(xlabel="relative size d / d_parent", ylabel="progeny passing (%)",
                 title="progeny of broken particles (fines included)")
-    axes[2].legend(fontsize=7)
+    if any(r.get("relative_sizes") for r in results):
+        axes[2].legend(fontsize=7)
+    else:                                     # nothing broke: no progeny to plot
+        axes[2].text(0.5, 0.5, "no particle broke", ha="center", transform=axes[2].transAxes)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
