@@ -218,9 +218,7 @@ def event_cost(sizes):
 def _mill_args(out):
     """The default mill of scripts/ball_mill.py."""
     from argparse import Namespace
-    from yadebreak import load_material
-    return Namespace(material="limestone", materials={"material": load_material("limestone")},
-                     size=8e-3, ball_size=25e-3, drum_diameter=0.25,
+    return Namespace(material="limestone", size=8e-3, ball_size=25e-3, drum_diameter=0.25,
                      drum_length=0.1, lifters=8, lifter_height=10e-3, lifter_width=10e-3,
                      speed=0.75, ball_filling=0.3, ore_filling=0.1, duration=1.0,
                      stiffness_scale=1e-3, time_step_fraction=0.05,
@@ -231,13 +229,15 @@ def _mill_args(out):
 def mill(steps=3000, repeats=1):
     """The default mill once settled, run from the same saved state in each mode."""
     import tempfile
+    from yadebreak import load_material
     from yadebreak.jobs import mill as mill_scene
     print(f"\n4. The default ball mill (scripts/ball_mill.py), from the charge settled (median of "
           f"{repeats})")
     with tempfile.TemporaryDirectory() as out:
         args = _mill_args(out)
         engine.forget()
-        mill_scene.mill_scene(args, mill_scene._options(args, Path(out)))
+        mill_scene.mill_scene(args, mill_scene._options(args, Path(out)),
+                              load_material(args.material))
         saved = str(Path(out) / "settled.yade.gz")
         engine.save(saved)
         runs = {mode: [] for mode in MODES}

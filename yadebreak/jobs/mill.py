@@ -111,8 +111,8 @@ class Mill(skeleton.Job):
 
     def build(self):
         args = self.args
-        job_options.material_of(args)              # the ore's Material (args.materials), once
-        self.brk, self.info = mill_scene(args, _options(args, self.out))
+        self.brk, self.info = mill_scene(args, _options(args, self.out),
+                                         job_options.material_of(args))
         self.loop = {"initial_mass": self.brk.total_mass(), "initial_dt": view.time_step(),
                      "sieves": sieves_for(args).tolist(), "times": [], "passing": [],
                      "feed_mass": [], "charge_mass": [], "lever_arm": [], "torque_time": [],

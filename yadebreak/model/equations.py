@@ -341,10 +341,10 @@ def kappa_of_batch(specific_energy, e50, sigma, emax_ratio, A, b_prime, nodes=64
     energy, weight = _broken_quadrature(specific_energy, e50, sigma, emax_ratio, nodes)
     if energy is None or not np.isfinite(target):
         return math.nan
-    scaled = b_prime * specific_energy / energy
+    ratio = specific_energy / energy
 
     def gap(log_kappa):          # Eq. 8's mean less Eq. 7, falling as kappa grows
-        return A * float(weight @ -np.expm1(-scaled * math.exp(-log_kappa))) - target
+        return float(weight @ t10(ratio, A, b_prime, math.exp(log_kappa))) - target
     return math.exp(brentq(gap, math.log(0.05), math.log(20.0), xtol=1e-12))
 
 

@@ -16,10 +16,10 @@ Never imports yade.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import tomllib
-import dataclasses
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -235,11 +235,11 @@ class Key(NamedTuple):
         return cls(name, scaled.lo, not scaled.lo_open, scaled.hi, not scaled.hi_open, unit,
                    factor, default)
 
-    def read(self, table, where, problems, required=True):
+    def read(self, table, where, problems):
         """The key's value in `table` in SI (its default, or None and a problem, if absent or
         wrong)."""
         value = read_number(table, self.name, where, problems, self.lo, self.lo_inclusive,
-                            self.hi, self.hi_inclusive, self.unit, required, self.default)
+                            self.hi, self.hi_inclusive, self.unit, default=self.default)
         return None if value is None else value * self.factor
 
 
@@ -276,11 +276,11 @@ def _range_text(lo, lo_inc, hi, hi_inc):
     return f"{left}{lo:g}, {hi_txt}{right}"
 
 
-def read_number(table, key, where, problems, lo, lo_inc, hi, hi_inc, unit, required=True,
-                default=None):
-    """Read one number, checking type and range; append any problem and return None on failure."""
+def read_number(table, key, where, problems, lo, lo_inc, hi, hi_inc, unit, default=None):
+    """Read one number, checking type and range; append any problem and return None on failure
+    (absent: `default`, a problem if it is None)."""
     if key not in table:
-        if required and default is None:
+        if default is None:
             problems.append(f"{where}.{key}: missing (a number in {unit}, accepted range "
                             f"{_range_text(lo, lo_inc, hi, hi_inc)})")
             return None

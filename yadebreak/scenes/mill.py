@@ -95,12 +95,11 @@ def charge_counts(args):
 
 
 # -- the scene ----------------------------------------------------------------------------------------
-def mill_scene(args, options):
-    """Build the mill, settle the charge with the drum still, attach yadebreak and start the drum.
-    Returns (controller, info). `args`: the job's (args.materials: the Materials its options
-    name, jobs.options.read)."""
+def mill_scene(args, options, ore_material):
+    """Build the mill of the job's `args`, its ore of `ore_material` (a Material), settle the
+    charge with the drum still, attach yadebreak and start the drum. Returns (controller,
+    info)."""
     O.reset()
-    ore_material = args.materials["material"]
     ip2, mats = engine.add_materials({"ore": ore_material, "steel": "steel"},
                                        stiffness_scale=args.stiffness_scale)
     radius = 0.5 * args.drum_diameter

@@ -306,10 +306,9 @@ def part_of(kind, label):
     holds none that followed this scene (after O.load, or a part of an earlier scene)."""
     part = _LIVE.get(label)
     if part is None or _SCENE_OF[label] != current_scene() or not part.current():
-        cls = _KINDS.get(kind)
-        if cls is None and kind not in PART_MODULES:     # its module, named in its state
-            cls = part_class(kind, _saved(f"yadebreak_{kind}:{label}", {}).get("part_module"))
-        cls = cls or part_class(kind)
+        saved_module = (None if kind in _KINDS or kind in PART_MODULES     # a user's part not
+                        else _saved(f"yadebreak_{kind}:{label}", {}).get("part_module"))  # imported
+        cls = part_class(kind, saved_module)
         data = _saved(cls.tag_for(label), None)
         if data is None:
             data = cls.legacy_state(label)
