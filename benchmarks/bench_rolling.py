@@ -37,7 +37,7 @@ def _rate(layers, mode):
         loop = next(e for e in O.engines if type(e).__name__ == "InteractionLoop")
         loop.lawDispatcher.functors[0].includeMoment = False
     elif mode == "every step":
-        protocol.set_period("rolling", 1)
+        protocol.set_trigger("rolling", 1)
     # the runner after Newton's step calls the rolling part alone here: its time is the part's
     part = (None if mode == "none" else
             next(e for e in O.engines if getattr(e, "label", "") == protocol.runner_label(

@@ -40,7 +40,7 @@ PHASES = (
     ("judging", ("judge",), "engine/judging.py"),
     ("replacement", ("_break_all",), "engine/controller.py"),
     ("event log", ("record",), "engine/state.py"),
-    ("time step and damping", ("after_read", "release"), "engine/stepping.py"),
+    ("read schedule, damping", ("after_read", "release"), "engine/reads.py, stepping.py"),
 )
 
 

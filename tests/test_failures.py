@@ -73,7 +73,7 @@ def test_run_script_turns_a_failure_into_an_exit_code_and_a_line(capsys, excepti
 
 def test_a_warning_is_shown_once_naming_the_scripts_own_option(capsys):
     from yadebreak.engine.controller import YadebreakWarning
-    from yadebreak.engine.stepping import ReadSchedule
+    from yadebreak.engine.reads import ReadSchedule
     schedule = ReadSchedule.__new__(ReadSchedule)
     schedule.period, schedule.mode = 7, "fast"
     remedies = schedule.remedies()

@@ -66,6 +66,45 @@ def test_a_part_acts_every_period_and_its_state_survives_save_and_load(scene):
     assert restored.period == 3
 
 
+def test_a_part_acts_when_its_trigger_says_and_yade_does_the_waiting(scene):
+    """A trigger (parts/triggers.py) whose gaps double: the part acts at 0, 1, 3, 7, 15, and its
+    runner runs at those steps only (YADE's iterPeriod waits, not Python). An integer is a
+    Periodic trigger; set_trigger changes it from the last act on; anything else is refused."""
+    from yade import utils
+    from yadebreak import scenes
+    from yadebreak.engine import add_materials, run_steps
+    from yadebreak.engine.parts import protocol
+    from yadebreak.engine.parts.triggers import Periodic, Trigger, as_trigger
+
+    class Doubling(Trigger):
+        def __init__(self):
+            self.gap = 1
+
+        def next_step(self, now):
+            due, self.gap = now + self.gap, 2 * self.gap
+            return due
+
+    O = scene
+    ip2, _ = add_materials({"ore": "copper_ore"})
+    O.bodies.append(utils.sphere((0, 0, 0), 1e-3, material="ore"))
+    O.engines = scenes.hertz_engines(ip2)
+    part = _counter()("doubling")
+    part.trigger = Doubling()
+    protocol.install(part)
+    run_steps(20)
+    assert part.steps == [0, 1, 3, 7, 15]
+    runner = next(e for e in O.engines
+                  if getattr(e, "label", "") == protocol.runner_label(protocol.AFTER_NEWTON))
+    assert runner.nDone == 5
+    protocol.set_trigger("doubling", 2)              # due 2 steps after its last act (15):
+    run_steps(6)                                     # overdue at 20, then 22, 24
+    assert part.steps[5:] == [20, 22, 24] and part.period == 2
+    assert isinstance(as_trigger(3), Periodic) and as_trigger(3).next_step(10) == 13
+    for bad in (0, 2.5, True, "auto"):
+        with pytest.raises((ValueError, TypeError), match="accepted"):
+            as_trigger(bad)
+
+
 def test_a_part_with_an_unknown_hook_or_a_taken_kind_is_refused():
     from yadebreak.engine.parts import protocol
     _counter()

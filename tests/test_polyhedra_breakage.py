@@ -34,7 +34,7 @@ def _set_spin(body, spin):
 
 def _rigid(body, origin):
     """Momentum, angular momentum about `origin` and kinetic energy of a YADE body."""
-    from yadebreak.engine.cells_replacement import body_kinetic_energy
+    from yadebreak.engine.shapes.polyhedron import body_kinetic_energy
     s = body.state
     rot = np.array(s.ori.toRotationMatrix())
     inertia = rot @ np.diag(np.array(s.inertia)) @ rot.T

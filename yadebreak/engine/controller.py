@@ -3,7 +3,8 @@
 One Controller per attached engine; `attach()` (scene.py) makes it and its PyRunners call
 `step()` after the InteractionLoop and the zeroing before it. Each part lives in its own module:
 contacts (reading), criteria (judging), state (bodies, events, ledger), replacement, zeroing,
-stepping (read schedule, time step, fragment damping).
+reads (the read schedule: the trigger of the engine's part), stepping (time step, fragment
+damping).
 """
 from __future__ import annotations
 
@@ -21,7 +22,8 @@ from yadebreak.criteria import criterion_for
 from yadebreak.engine.judging import Judge, Rules
 from yadebreak.engine.replacement import Recipe, Replacer
 from yadebreak.engine.state import BREAKABLE, BROKEN, UNBREAKABLE, EngineState, assembled_columns
-from yadebreak.engine.stepping import FragmentDamping, ReadSchedule, TimeStep
+from yadebreak.engine.reads import read_schedule
+from yadebreak.engine.stepping import FragmentDamping, TimeStep
 from yadebreak.engine.tracking import Tracking
 from yadebreak.engine.zeroing import OverlapZeroing
 
@@ -54,7 +56,7 @@ class YadebreakWarning(RuntimeWarning):
                           lambda o: f"{o} (an attach() option)")
 
 
-#: said once where the volumetric law is read (contacts/volumetric.PairChecks)
+#: said once where the scene's law counts YADE's do_intersect warnings (contacts/volumetric.py)
 PAIR_CHECKS_SILENCED = ("YADE's warning \"Unhandled switch case:0, function do_intersect\" is "
                         "silenced: it comes at every step for every pair of polyhedra whose "
                         "bounding boxes overlap without touching, harmless (docs/polyhedra.md); "
@@ -89,15 +91,15 @@ class Controller:
                                     config.reading.emin, scene_materials.law)
         self.zeroing = OverlapZeroing(config.replacement.local_damping, label + "_zero",
                                       config.replacement.zeroing_tolerance)
-        volumetric = scene_materials.law == "volumetric"
-        if volumetric:
+        law = scene_materials.law
+        if law.pair_checks is not None:
             silence_polyhedra_pair_checks()
             self.warn_once("pair_checks", PAIR_CHECKS_SILENCED)
-        fast = config.reading.read_period == "fast" and not volumetric
+        fast = config.reading.read_period == "fast" and not law.reads_every_step
         self.tracking = Tracking(self.state, config.reading.fast_tolerance if fast else None)
-        self.schedule = ReadSchedule(config.reading, label, self.tracking.smallest_breakable,
-                                     self.tracking.reach_now if fast else None,
-                                     every_step=volumetric)
+        self.schedule = read_schedule(config.reading, self.tracking.smallest_breakable,
+                                      self.tracking.reach_now if fast else None,
+                                      every_step=law.reads_every_step)
         self.time_step = TimeStep(config.time_step.time_step_fraction, self.warn_once)
         gd = config.time_step.global_damping        # None: each material file's
         self.damping = FragmentDamping(
@@ -146,7 +148,7 @@ class Controller:
     @property
     def polyhedra_pair_checks(self):
         """YADE's silenced do_intersect warnings in this process (contacts/volumetric.PairChecks;
-        None off the volumetric law)."""
+        None where the scene's law counts none)."""
         checks = self.reader.pair_checks
         return None if checks is None else checks.count
 

@@ -8,13 +8,13 @@ from collections.abc import Mapping
 
 from yadebreak import model
 from yadebreak.model.intervals import DENSITY, POISSON_RATIO, YOUNG_MODULUS, Interval
-from yadebreak.model.cells import sieve_size
 from yadebreak.model.materials import Material, MaterialError
 from yadebreak.criteria import load_material
 from yadebreak.adapter.yade_api import O, extend_match_makers, wrapper
 from yadebreak.options.table import AttachError
 from yadebreak.criteria import criterion_for
 from yadebreak.engine.parts.rolling import share_pairs as share_rolling_pairs
+from yadebreak.engine.shapes import SHAPES, shape_of
 from yadebreak.engine.state import Breakable
 
 
@@ -162,10 +162,10 @@ class SceneMaterials:
     by_label: dict          # YADE label -> Material (breakable)
     label_by_id: dict       # YADE material id -> label, for breakable materials
     stiffness_by_id: dict   # YADE material id -> the stiffness of Eq. 4's shares: Hertz's
-    #                         Y / (1 - nu^2) (Pa; inf if rigid), or on the volumetric law kn
-    #                         (N/m3: PolyhedraMat.young)
+    #                         Y / (1 - nu^2) (Pa; inf if rigid), or the law's own (the
+    #                         volumetric law's kn, N/m3: PolyhedraMat.young)
     dummy_by_label: dict    # breakable label -> YADE material of its softer dummies (if made)
-    law: str = "hertz_mindlin"   # the contact law the engine reads (contacts.reader.LAWS)
+    law: object             # the contact law the engine reads (a contacts.laws instance)
 
 
 def check_mapping(materials):
@@ -192,24 +192,26 @@ def check_mapping(materials):
     return found
 
 
-#: on YADE's volumetric law a PolyhedraMat's `young` is its kn (N/m3), not a Young's modulus
-_VOLUMETRIC = (("young", Interval(0.0, math.inf, lo_open=True, hi_open=True), "N/m3"),
+#: a material whose `young` is its law's own stiffness (the volumetric law's kn, N/m3), not a
+#: Young's modulus
+_OWN_STIFFNESS = (("young", Interval(0.0, math.inf, lo_open=True, hi_open=True), "N/m3"),
                *_PHYSICAL[1:])
 
 
-def resolve(materials, kappa=None, emax_ratio=None, law="hertz_mindlin"):
+def resolve(materials, law, kappa=None, emax_ratio=None):
     """Map the checked {label: Material} (check_mapping) onto the scene's labelled YADE
     materials, with the options that override the files (Tavares materials only). `law`: the
-    contact law the engine reads (scene.contact_law). A `kappa` that is a word ('batch') is
-    the criterion's to apply (recording.criterion_for), not a number to write into the file."""
+    contact law the engine reads (scene.contact_law, a contacts.laws instance). A `kappa` that
+    is a word ('batch') is the criterion's to apply (recording.criterion_for), not a number to
+    write into the file."""
     kappa = None if isinstance(kappa, str) else kappa
     by_label = {lab: criterion_for(mat).overridden(kappa=kappa, emax_ratio=emax_ratio)
                 for lab, mat in materials.items()}
     stiffness, label_by_id = {}, {}
-    volumetric = law == "volumetric"
     for m in O.materials:
-        kn = volumetric and isinstance(m, wrapper.PolyhedraMat)
-        check_physical(m, f"YADE material {m.label or m.id!r}", _VOLUMETRIC if kn else _PHYSICAL)
+        kn = law.young_is_stiffness(m)
+        check_physical(m, f"YADE material {m.label or m.id!r}",
+                       _OWN_STIFFNESS if kn else _PHYSICAL)
         young = getattr(m, "young", None)
         stiffness[m.id] = (math.inf if young is None else float(young) if kn
                            else float(model.hertz_stiffness(young, getattr(m, "poisson", 0.0))))
@@ -221,31 +223,27 @@ def resolve(materials, kappa=None, emax_ratio=None, law="hertz_mindlin"):
     return SceneMaterials(by_label, label_by_id, stiffness, dummies, law)
 
 
-def breakable_spheres(label_by_id):
+def breakable_bodies(label_by_id):
     """state.Breakable records of the scene's bodies with a breakable material (attach only:
-    a pass over every body): loose spheres, and convex polyhedra (YADE Polyhedra), whose
-    `radius` is half their sieve size (model.cells.sieve_size: 2 radius is the size of Eq. 3 and
-    of the t10 sieves, as a sphere's diameter is). Anything else with such a material is an
-    error."""
+    a pass over every body): loose bodies of a shape that can break (engine/shapes/), whose
+    `radius` is half their size (Shape.size: Eq. 3's and the t10 sieves'). Anything else with
+    such a material is an error."""
     found, problems = [], []
     for b in O.bodies:
         label = label_by_id.get(b.material.id if b is not None and b.material is not None
                                 else None)
         if label is None:
             continue
-        polyhedron = isinstance(b.shape, wrapper.Polyhedra)
-        if not (polyhedron or isinstance(b.shape, wrapper.Sphere)):
+        shape = shape_of(b)
+        if shape is None:
+            names = " and ".join(s.plural for s in SHAPES.values())
             problems.append(f"body {b.id} ({type(b.shape).__name__}) has the breakable material "
-                            f"'{label}' but only spheres and polyhedra can break: give it another "
-                            "material")
+                            f"'{label}' but only {names} can break: give it another material")
         elif b.isClumpMember or b.isClump:
             problems.append(f"body {b.id} is part of a clump and has the breakable material "
-                            f"'{label}': clumps cannot break; use loose spheres")
-        elif polyhedron:
-            size = sieve_size([tuple(v) for v in b.shape.v])
-            found.append(Breakable(b.id, label, b.state.mass, 0.5 * size))
+                            f"'{label}': clumps cannot break; use loose bodies")
         else:
-            found.append(Breakable(b.id, label, b.state.mass, b.shape.radius))
+            found.append(Breakable(b.id, label, b.state.mass, 0.5 * shape.size(b)))
     if problems:
         raise AttachError("; ".join(problems))
     return found

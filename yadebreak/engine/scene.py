@@ -15,8 +15,9 @@ from yadebreak.engine.parts import protocol
 from yadebreak.adapter.yade_api import (O, close_remote_access, find_engine, scene_folder,
                                         wrapper)
 from yadebreak.options.table import AttachError, Config
+from yadebreak.engine.contacts.laws import laws_in
 from yadebreak.engine.controller import Controller
-from yadebreak.engine.materials import breakable_spheres, check_mapping, dummy_materials, resolve
+from yadebreak.engine.materials import breakable_bodies, check_mapping, dummy_materials, resolve
 from yadebreak.engine.state import EventLog
 from yadebreak.engine.stepping import smallest_rayleigh_time
 
@@ -28,15 +29,15 @@ YADE_DEFAULT_DT = 1e-8
 
 
 class BreakageEngine(protocol.Part):
-    """The engine's read, after the InteractionLoop every `period` steps (the read schedule's:
-    it sets it through protocol.set_period); its state is the controller's (_state)."""
+    """The engine's read, after the InteractionLoop when its trigger, the read schedule
+    (engine/reads.py), says; its state is the controller's (_state)."""
 
     kind = "breakage"
     hook = protocol.AFTER_INTERACTIONS
 
     def __init__(self, label, controller):
         self.controller = controller
-        super().__init__(label, controller.period)
+        super().__init__(label, controller.schedule)
 
     @property
     def period(self):
@@ -80,8 +81,17 @@ class Zeroing(protocol.Part):
     kind = "breakage_zero"
     hook = protocol.BEFORE_INTERACTIONS
 
+    zeroing = None                           # the controller's, as found at the last act
+
     def act(self):
-        controller_of(self.label.removesuffix("_zero")).zero_overlaps()
+        ctl = controller_of(self.label.removesuffix("_zero"))
+        self.zeroing = ctl.zeroing
+        ctl.zero_overlaps()
+
+    def next_step(self, now):
+        """Its trigger is the zeroing's own (zeroing.OverlapZeroing.next_step)."""
+        zeroing = self.zeroing or controller_of(self.label.removesuffix("_zero")).zeroing
+        return zeroing.next_step(now)
 
     @classmethod
     def legacy_state(cls, label):
@@ -108,28 +118,25 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     if not config.output.remote_access:
         _close_remote_access()
     loop_idx, law = contact_law(engines)
-    if law == "volumetric" and config.reading.cs > 0.0:
-        raise AttachError(f"cs = {config.reading.cs:g}: the volumetric law's shear work is not "
-                          "read; accepted 0 with polyhedra on Law2_PolyhedraGeom_PolyhedraPhys_"
-                          "Volumetric")
+    problem = law.problems(config.reading)
+    if problem:
+        raise AttachError(problem)
     label_ids = {m.id: m.label for m in O.materials if m.label in materials}
-    spheres = breakable_spheres(label_ids)
-    _check_not_tracked_elsewhere(label, [s[0] for s in spheres])
+    breakable = breakable_bodies(label_ids)
+    _check_not_tracked_elsewhere(label, [s[0] for s in breakable])
     # every check is done: from here on the scene changes
     dummy_materials(materials, config.replacement.dummy_stiffness, engines[loop_idx])
-    scene_materials = resolve(found, config.criteria.kappa, config.criteria.emax_ratio, law)
+    scene_materials = resolve(found, law, config.criteria.kappa, config.criteria.emax_ratio)
     ctl = Controller(label, config, scene_materials, materials)
-    ctl.register(spheres)
+    ctl.register(breakable)
     if not len(ctl.bodies):
         ctl.warn_once("empty", "the scene has no breakable body: nothing will break (materials "
                       f"mapped: {sorted(materials)})")
     ctl.state.log.start()
     ctl.damping.apply_at_attach()
     user_dt = None if O.dt == YADE_DEFAULT_DT else O.dt
-    if law == "volumetric" and user_dt is None:
-        ctl.warn_once("dt", f"O.dt is YADE's default {O.dt:g} s: the engine sets no time step "
-                      "for polyhedra on the volumetric law; set O.dt before attach (the "
-                      "scenes use 1 % of a particle's Rayleigh time: docs/polyhedra.md)")
+    if law.time_step_advice and user_dt is None:
+        ctl.warn_once("dt", f"O.dt is YADE's default {O.dt:g} s: {law.time_step_advice}")
     ctl.time_step.at_attach(smallest_rayleigh_time(), user_dt)
     ctl.last_iter = O.iter - 1
     protocol.install(BreakageEngine(label, ctl), engines)
@@ -138,30 +145,25 @@ def attach(materials, seed=0, *, label="yadebreak", **options):
     return ctl
 
 
-#: YADE's laws whose contacts the engine reads, and the reader's name of each
-READ_LAWS = (("Law2_ScGeom_MindlinPhys_Mindlin", "hertz_mindlin"),
-             ("Law2_PolyhedraGeom_PolyhedraPhys_Volumetric", "volumetric"))
-
-
 def contact_law(engines):
-    """(index of the InteractionLoop in `engines`, the law the engine reads there): Hertz-Mindlin
-    (spheres, and polyhedra through ScGeom) or the volumetric law of polyhedra, one per scene
-    (docs/polyhedra.md: the two cannot meet in one scene)."""
+    """(index of the InteractionLoop in `engines`, the law the engine reads there, a
+    contacts.laws instance): Hertz-Mindlin (spheres, and polyhedra through ScGeom) or the
+    volumetric law of polyhedra, one per scene (docs/polyhedra.md: the two cannot meet in one
+    scene)."""
     loop_idx = next((k for k, e in enumerate(engines) if isinstance(e, wrapper.InteractionLoop)),
                     None)
     if loop_idx is None:
         raise AttachError("O.engines has no InteractionLoop: set O.engines (with "
                           "Law2_ScGeom_MindlinPhys_Mindlin) before calling yadebreak.attach")
     names = {type(f).__name__ for f in engines[loop_idx].lawDispatcher.functors}
-    found = [ours for theirs, ours in READ_LAWS if theirs in names]
+    found = laws_in(names)
     if not found:
         raise AttachError("the InteractionLoop has no Law2_ScGeom_MindlinPhys_Mindlin: yadebreak "
                           "reads YADE's Hertz-Mindlin forces (use add_materials() for the Ip2), or "
                           "for polyhedra Law2_PolyhedraGeom_PolyhedraPhys_Volumetric")
     if len(found) > 1:
-        raise AttachError("the InteractionLoop has both Law2_ScGeom_MindlinPhys_Mindlin and "
-                          "Law2_PolyhedraGeom_PolyhedraPhys_Volumetric: yadebreak reads one "
-                          "contact law per scene")
+        raise AttachError(f"the InteractionLoop has {' and '.join(law.yade_law for law in found)}"
+                          ": yadebreak reads one contact law per scene")
     return loop_idx, found[0]
 
 
@@ -280,8 +282,8 @@ def _restore(label, data, period):
             f"on before it was saved: O.save does not store yadebreak's state; save scenes with "
             f"yadebreak.save(path)")
     config = Config.from_options(**{**data["options"], "event_log": _stored_event_log(data)})
-    scene_materials = resolve(check_mapping(data["materials"]), config.criteria.kappa,
-                              config.criteria.emax_ratio, contact_law(list(O.engines))[1])
+    scene_materials = resolve(check_mapping(data["materials"]), contact_law(list(O.engines))[1],
+                              config.criteria.kappa, config.criteria.emax_ratio)
     ctl = Controller(label, config, scene_materials, data["materials"], data["state"])
     own = find_engine(label)                  # a PyRunner of its own (older scenes)
     ctl.schedule.period = own.iterPeriod if own is not None else period

@@ -9,7 +9,7 @@ import numpy as np
 from yadebreak.model import placement
 from yadebreak.adapter.yade_api import O
 from yadebreak.engine.state import BREAKABLE, UNBREAKABLE
-from yadebreak.engine.stepping import Reach, SmallestBreakable
+from yadebreak.engine.reads import Reach, SmallestBreakable
 
 
 class Tracking:

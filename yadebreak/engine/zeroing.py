@@ -60,8 +60,6 @@ class OverlapZeroing:
         self._loaded_depth = {}                  # wall, facet pair -> overlap (m) when saved
         self._changes = set()                    # pairs zeroed, dropped, asleep or woken
         #                                          since take_changes() (None: not kept)
-        self._period = None                      # the runner's period as last set (None:
-        #                                          not known: restored)
 
     def __bool__(self):
         return bool(self.pairs)
@@ -125,13 +123,16 @@ class OverlapZeroing:
     def wake(self):
         """Pairs were zeroed: visit every step from the next on."""
         if self.pairs:
-            self._visit_every(1)
             protocol.wake(self.engine_label)
 
-    def _visit_every(self, steps):
-        if steps != self._period:
-            self._period = steps
-            protocol.set_period(self.engine_label, steps)
+    def next_step(self, now):
+        """The step of the next visit (the zeroing part's trigger, asked after a visit at `now`
+        and when woken): the next step while a pair is awake; with every pair asleep, when the
+        first wakes (entries of pairs dropped meanwhile may make it earlier: a visit that finds
+        nothing to do)."""
+        if not self.awake and self._wake_at:
+            return now + max(1, min(self._wake_at) - now)
+        return now + 1
 
     def apply(self):
         """Before the InteractionLoop: scale kno, kso of every zeroed pair awake (sphere pairs
@@ -196,10 +197,6 @@ class OverlapZeroing:
             del self.awake[key]
             self.asleep.add(key)
             self._wake_at.setdefault(when, []).append(key)
-        # every pair asleep: the next visit is when the first wakes (entries of pairs dropped
-        # meanwhile may make it earlier: a visit that finds nothing to do)
-        self._visit_every(max(1, min(self._wake_at) - now) if not self.awake and self._wake_at
-                          else 1)
 
     def _wake(self, now):
         """The pairs due now are awake again (pairs dropped while asleep are gone); returns them

@@ -7,7 +7,7 @@ from typing import NamedTuple
 
 from yadebreak.adapter.yade_api import O
 from yadebreak.engine.parts.protocol import Part, install
-from yadebreak.engine.replacement import contact_elastic_energy
+from yadebreak.engine.contacts.hertz import contact_elastic_energy
 
 
 class EnergyNow(NamedTuple):

@@ -14,7 +14,7 @@ from yadebreak.model import placement
 from yadebreak.engine import add_materials, attach, run_steps
 from yadebreak.engine.materials import as_material
 from yadebreak.engine.parts.rolling import install_rolling
-from yadebreak.engine.cells_replacement import body_kinetic_energy
+from yadebreak.engine.shapes.polyhedron import body_kinetic_energy
 from yadebreak.scenes.polyhedra import volumetric_impact_scene
 from yadebreak.adapter.yade_api import O, engine_time, utils, wrapper as _w
 from yadebreak.process.files import append_whole

@@ -21,7 +21,7 @@ import numpy as np
 
 from yadebreak.adapter.yade_api import Matrix3, O, Quaternion, Vector3, utils, wrapper as _w
 from yadebreak.engine import add_materials, attach
-from yadebreak.engine.cells_replacement import skipped_turn
+from yadebreak.engine.shapes.polyhedron import skipped_turn
 from yadebreak import model
 from yadebreak.model import placement
 from yadebreak.model.cells import convex_polyhedron, random_convex_vertices, sieve_size
@@ -71,7 +71,7 @@ def polyhedron(vertices, material, position=(0.0, 0.0, 0.0), velocity=(0.0, 0.0,
     `material`, its centroid at `position`. YADE re-centres the shape on its centroid, turns it
     to its principal axes and gives its volume and inertia exactly; mass and inertia are those
     times the density. `fixed`: every degree of freedom blocked (a plate). Not appended.
-    A small body, whose turn to its principal axes YADE skips (cells_replacement.skipped_turn),
+    A small body, whose turn to its principal axes YADE skips (engine.shapes.polyhedron.skipped_turn),
     is given to YADE in them."""
     mat = _material(material)
     pts = np.asarray(vertices, dtype=float)

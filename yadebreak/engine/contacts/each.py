@@ -13,8 +13,6 @@ from yadebreak.engine.contacts.table import (FORCE, OFFSET_A, OFFSET_B, OVERLAP,
                                              SHARE_A, SHARE_B, SHEAR_DISP, SHEAR_FORCE,
                                              SHEAR_WORK, TIME_BEFORE, TIME_READ, WORK, fresh_row)
 from yadebreak.engine.contacts.loading import Loading, StrongestContacts
-from yadebreak.engine.contacts.volumetric import advance as volumetric_advance
-from yadebreak.engine.contacts.volumetric import fresh as volumetric_row
 
 _law = HertzMindlinWork
 
@@ -65,12 +63,9 @@ def _start_here(row, geom, phys, cs):
         row[SHEAR_FORCE] = phys.shearForce.norm()
 
 
-def read_each(reader, real, bodies, tracked, zeroed, now, interval, asleep, previous=None):
-    """One read of `real` (YADE's real interactions) into reader.table; returns the Loading.
-    On the volumetric law (reader.volumetric) each contact is brought to the present by
-    volumetric.py's rule, `previous` the time (s) of the last read."""
+def read_each(reader, real, bodies, tracked, zeroed, now, interval, asleep):
+    """One read of `real` (YADE's real interactions) into reader.table; returns the Loading."""
     table, cs, emin, inherited = reader.table, reader.cs, reader.emin, reader.inherited
-    volumetric = reader.volumetric
     first_touch = _law.first_touch_factor(interval)
     index = table.index
     if index is None:             # the last read was numpy's
@@ -92,8 +87,6 @@ def read_each(reader, real, bodies, tracked, zeroed, now, interval, asleep, prev
             geom = old_geoms[j]
             if geom is None:                              # restored from a save
                 row, geom, phys = old_rows[j], inter.geom, inter.phys
-            elif volumetric:
-                row, phys = old_rows[j], old_physs[j]
             else:
                 delta = geom.penetrationDepth
                 if delta < 0.0:       # the law erased it after the last read, YADE made it anew
@@ -103,19 +96,11 @@ def read_each(reader, real, bodies, tracked, zeroed, now, interval, asleep, prev
                     update = not (asleep and pair in asleep)   # a slack zeroed pair: no work
         if j is None:
             geom, phys = inter.geom, inter.phys
-            if volumetric:
-                row = volumetric_row(reader.stiffness, bodies, a, b, phys, now, previous,
-                                     inherited and pair in inherited)
-            else:
-                row = fresh_row(reader.stiffness, bodies, a, b, now)
-                if inherited and pair in inherited:
-                    _start_here(row, geom, phys, cs)
-        if volumetric:
-            worked = volumetric_advance(row, geom, phys, bodies[a].state, bodies[b].state, now)
-        else:
-            worked = update and _advance(row, geom, phys, delta, paired and pair in zeroed,
-                                         first_touch, cs, now)
-        if worked:
+            row = fresh_row(reader.stiffness, bodies, a, b, now)
+            if inherited and pair in inherited:
+                _start_here(row, geom, phys, cs)
+        if update and _advance(row, geom, phys, delta, paired and pair in zeroed, first_touch, cs,
+                               now):
             if in_a:
                 grew.add(a)
             if in_b:

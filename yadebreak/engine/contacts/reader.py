@@ -9,9 +9,10 @@ of a whole run (CPU time, a read every step, breakage out of reach, medians of 6
 particles hitting a plate 60 us per step contact by contact, 196 us with numpy; the default bed
 (44 contacts) 208 against 303 us; a bed of 5 layers (203 contacts) 2095 against 1366 us. Per read
 alone: 4 contacts 9 against 64 us, 44 contacts 65 against 107 us, 203 contacts 308 against 281
-us. Both call the physics of a contact (law.py) on floats or on arrays.
-Polyhedra on YADE's volumetric law take a read of their own (volumetric.py): the work of the
-force over the approach of the bodies' material points.
+us. Both call the physics of a contact (law.py) on floats or on arrays. Which read a scene
+takes, and what a row holds, is its contact law's (laws.py): Hertz-Mindlin (hertz.py) chooses
+between the two paths; polyhedra on YADE's volumetric law take a read of their own
+(volumetric.py): the work of the force over the approach of the bodies' material points.
 Duck-typed on YADE's interaction container, geometry and physics objects; no yade import.
 """
 from __future__ import annotations
@@ -19,9 +20,8 @@ from __future__ import annotations
 import numpy as np
 
 from yadebreak.engine.contacts.arrays import ArrayRead
-from yadebreak.engine.contacts.each import read_each
+from yadebreak.engine.contacts.hertz import HertzMindlin
 from yadebreak.engine.contacts.law import HertzMindlinWork, total_work
-from yadebreak.engine.contacts.volumetric import PairChecks, held_share, held_total
 from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OFFSETS, OVERLAP, SHARE_A,
                                              SHARE_B, SHARES, SHEAR_WORK, WORK, ContactTable,
                                              take)
@@ -30,22 +30,17 @@ from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OFFSETS, OVERLA
 #: with numpy: measured, the scalar path costs about 1.7 us per contact, the numpy one about
 #: 0.7 us per contact plus 100 us per read (per step, see the module's docstring)
 SMALL = 150
-#: the contact laws whose work a reader counts
-LAWS = ("hertz_mindlin", "volumetric")
 
 
 class ContactReader:
     """The contacts of tracked bodies (`table`, one row per contact), read when the schedule
     says, and what the engine tells them between reads (erased bodies, inherited pairs)."""
 
-    def __init__(self, stiffness_by_material_id, cs, emin, law="hertz_mindlin"):
-        if law not in LAWS:
-            raise ValueError(f"law = {law!r}: accepted {LAWS}")
+    def __init__(self, stiffness_by_material_id, cs, emin, law=None):
         self.stiffness = stiffness_by_material_id     # YADE material id -> the stiffness of
-        #                                               Eq. 4's shares (Pa; N/m3 on "volumetric")
-        self.volumetric = law == "volumetric"
-        #: on the volumetric law: the checks YADE's silenced do_intersect warning counts
-        self.pair_checks = PairChecks() if self.volumetric else None
+        #                                               Eq. 4's shares (Pa; the law's own kn
+        #                                               where law.young_is_stiffness)
+        self.contact_law = law if law is not None else HertzMindlin()   # laws.py
         self.last_time = None                         # O.time at the last read
         self.cs = cs
         self.emin = emin
@@ -54,7 +49,7 @@ class ContactReader:
         self.inherited = set()                        # (smaller id, larger id): see inherit()
         self.erased_bodies = set()                    # bodies gone since the last read
         self.small = SMALL                            # see SMALL (tests set it to choose a path)
-        self._read_arrays = ArrayRead(self)
+        self.arrays = ArrayRead(self)                 # the numpy read (Hertz-Mindlin's)
 
     def __len__(self):
         return len(self.table)
@@ -69,16 +64,8 @@ class ContactReader:
         around the bodies whose count changed; `zeroing_changes`, the pairs that entered or left
         `zeroed` or `asleep` since the last read (None: unknown), spares it looking every row up
         in them again."""
-        if self.pair_checks is not None:
-            self.pair_checks.add(interactions, bodies)
-        if self.volumetric or counts is None or len(self.table) <= self.small:
-            loading = read_each(self, interactions.all(True), bodies, tracked, zeroed, now,
-                                interval, asleep,
-                                self.last_time if self.last_time is not None else now)
-            self._read_arrays.zeroed_rows.forget()    # it does not follow the zeroing's changes
-        else:
-            loading = self._read_arrays(interactions, bodies, tracked, zeroed, now, interval,
-                                        asleep, counts, zeroing_changes)
+        loading = self.contact_law.read(self, interactions, bodies, tracked, zeroed, now,
+                                        interval, asleep, counts, zeroing_changes)
         self.inherited.clear()                 # read now or gone
         self.erased_bodies.clear()
         self.last_time = now
@@ -86,21 +73,22 @@ class ContactReader:
 
     # -- one body's contacts -------------------------------------------------------------------
     def stored_share(self, body):
-        """Elastic energy (J) a body holds now in its counted contacts: its share of the Hertz
-        energy, with kno as the law uses it (scaled for zeroed pairs)."""
+        """Elastic energy (J) a body holds now in its counted contacts: its share (Eq. 4) of
+        what each holds, as its law says (Hertz: with kno as the law uses it, scaled for zeroed
+        pairs)."""
         table = self.table
-        if self.volumetric:
-            return held_share(table, body, self.cs, self.emin)
         if table.is_block:
             return self.stored_shares([body])[0]
         total = 0.0
         rows, physs, cs, emin = table.row_lists(), table.physs, self.cs, self.emin
+        held = self.contact_law.held
         for k, side in table.rows_of(body):
             row = rows[k]
-            overlap = row[OVERLAP]
-            if (overlap > 0.0 and total_work(row[WORK], row[SHEAR_WORK], cs)
-                    - row[OFFSET_B if side else OFFSET_A] >= emin):
-                total += row[SHARE_B if side else SHARE_A] * self.law.stored(physs[k].kno, overlap)
+            if total_work(row[WORK], row[SHEAR_WORK], cs) - row[OFFSET_B if side else OFFSET_A] \
+                    >= emin:
+                energy = held(table, k, physs)
+                if energy > 0.0:
+                    total += row[SHARE_B if side else SHARE_A] * energy
         return total
 
     def stored_shares(self, bodies):
@@ -108,7 +96,7 @@ class ContactReader:
         cloud's open events ask every read whether their bodies unloaded. Each body's sum is
         taken in the order of its rows, as the loop over a body's rows takes it."""
         table = self.table
-        if self.volumetric or not table.is_block:
+        if not table.is_block:
             return [self.stored_share(b) for b in bodies]
         d = table.data
         overlap, work = d[OVERLAP], total_work(d[WORK], d[SHEAR_WORK], self.cs)
@@ -132,10 +120,11 @@ class ContactReader:
             totals[place] += share * stored(phys.kno, overlap_now)
         return totals
 
-    def held(self, body):
-        """Elastic energy (J) a body's volumetric contacts hold, both sides
-        (contacts/volumetric)."""
-        return held_total(self.table, body)
+    @property
+    def pair_checks(self):
+        """YADE's silenced warnings the law counts (volumetric.PairChecks), None if it counts
+        none."""
+        return self.contact_law.pair_checks
 
     def restart(self, body):
         """Count a body's energy from now on: its offsets become its contacts' present work."""

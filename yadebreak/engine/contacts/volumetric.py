@@ -15,14 +15,20 @@ stressing energy, as for Hertz-Mindlin: what the criteria judge) in WORK, and th
 integral over loading and unloading, the elastic energy the contact holds (the law is elastic in
 the normal direction), in HELD. OVERLAP holds the approach since the contact began (m).
 
-Read every step (the schedule reads polyhedra on this law every step: between reads the approach
-is extrapolated from the velocities of one instant), by the scalar read (each.py), which calls
-fresh() and advance() for each contact. Duck-typed on YADE's objects; no yade import.
+Read every step (Volumetric.reads_every_step: between reads the approach is extrapolated from
+the velocities of one instant), contact by contact (read_rows, calling fresh() and advance() for
+each). Volumetric is what the reader and the replacer ask of this law (laws.py lists the laws).
+Duck-typed on YADE's objects; no yade import.
 """
 from __future__ import annotations
 
+import numpy as np
+
+from yadebreak.engine.contacts.law import own_share, total_work
+from yadebreak.engine.contacts.loading import Loading, StrongestContacts
 from yadebreak.engine.contacts.table import (FORCE, OFFSET_A, OFFSET_B, OVERLAP, OVERLAP_BEFORE,
-                                             SHARE_A, SHARE_B, TIME_READ, WORK, fresh_row)
+                                             SHARE_A, SHARE_B, SHEAR_WORK, TIME_READ, WORK,
+                                             fresh_row)
 
 #: the column of a volumetric row that holds its elastic energy (J): the running integral of
 #: F d(delta); a Hertz row keeps the overlap of the read before there
@@ -64,18 +70,6 @@ def advance(row, geom, phys, state_a, state_b, now):
     return False
 
 
-def held_share(table, body, cs, emin):
-    """Elastic energy (J) a body holds now in its counted volumetric contacts: its share of what
-    each holds."""
-    total = 0.0
-    value = table.value
-    for row, side in table.rows_of(body):
-        offset = value(row, OFFSET_B if side else OFFSET_A)
-        held = value(row, HELD)
-        if table.total(row, cs) - offset >= emin and held > 0.0:
-            total += value(row, SHARE_B if side else SHARE_A) * held
-    return total
-
 
 class PairChecks:
     """What YADE's warning "Unhandled switch case:0, function do_intersect" would count. Its
@@ -110,6 +104,101 @@ class PairChecks:
         self.touching = touching
 
 
-def held_total(table, body):
-    """Elastic energy (J) a body's volumetric contacts hold, both sides."""
-    return sum(max(table.value(row, HELD), 0.0) for row, _ in table.rows_of(body))
+
+def read_rows(reader, real, bodies, tracked, now, previous):
+    """One read of `real` (YADE's real interactions) into reader.table, each contact brought to
+    the present by advance(); `previous` the time (s) of the last read. Returns the Loading."""
+    table, cs, emin, inherited = reader.table, reader.cs, reader.emin, reader.inherited
+    index = table.index
+    if index is None:
+        index = dict(zip(zip(table.a.tolist(), table.b.tolist()), range(len(table.a))))
+    old_rows, old_geoms, old_physs = table.row_lists(), table.geoms, table.physs
+    a_list, b_list, rows, geoms, physs = [], [], [], [], []
+    energy, found, grew, by_body, new_index = {}, {}, set(), {}, {}
+    for inter in real:
+        a, b = inter.id1, inter.id2
+        in_a, in_b = a in tracked, b in tracked
+        if not (in_a or in_b):
+            continue
+        j = index.get((a, b))
+        if j is None:
+            geom, phys = inter.geom, inter.phys
+            row = fresh(reader.stiffness, bodies, a, b, phys, now, previous,
+                        bool(inherited) and ((a, b) if a < b else (b, a)) in inherited)
+        elif old_geoms[j] is None:                        # restored from a save
+            row, geom, phys = old_rows[j], inter.geom, inter.phys
+        else:
+            row, geom, phys = old_rows[j], old_geoms[j], old_physs[j]
+        if advance(row, geom, phys, bodies[a].state, bodies[b].state, now):
+            grew.update(i for i, mine in ((a, in_a), (b, in_b)) if mine)
+        k = len(rows)
+        new_index[(a, b)] = k
+        rows.append(row)
+        a_list.append(a)
+        b_list.append(b)
+        geoms.append(geom)
+        physs.append(phys)
+        total = total_work(row[WORK], row[SHEAR_WORK], cs)
+        for body, other, mine, offset, share, sign in ((a, b, in_a, OFFSET_A, SHARE_A, 1.0),
+                                                       (b, a, in_b, OFFSET_B, SHARE_B, -1.0)):
+            if not mine:
+                continue
+            by_body.setdefault(body, []).append((k, 0 if sign > 0.0 else 1))
+            counted, own = own_share(total, row[offset], row[share], emin)
+            if counted:
+                energy[body] = energy.get(body, 0.0) + own
+                if own > found.get(body, (0.0,))[0]:
+                    found[body] = (own, k, sign, other)
+    table.set(np.array(a_list, np.int64), np.array(b_list, np.int64), None, geoms, physs, rows=rows,
+              by_body=by_body, index=new_index)
+    return Loading(energy, StrongestContacts(found, geoms), grew)
+
+
+class Volumetric:
+    """The reader's view of Law2_PolyhedraGeom_PolyhedraPhys_Volumetric: read every step,
+    contact by contact (read_rows); YADE's do_intersect warnings counted (PairChecks)."""
+
+    name = "volumetric"
+    yade_law = "Law2_PolyhedraGeom_PolyhedraPhys_Volumetric"
+    #: between reads the approach would be extrapolated from one instant's velocities
+    reads_every_step = True
+    #: said once when the engine attaches to a scene on this law with YADE's default O.dt
+    time_step_advice = ("the engine sets no time step for polyhedra on the volumetric law; set "
+                        "O.dt before attach (the scenes use 1 % of a particle's Rayleigh time: "
+                        "docs/polyhedra.md)")
+
+    def __init__(self):
+        #: the checks YADE's silenced do_intersect warning counts
+        self.pair_checks = PairChecks()
+
+    def problems(self, reading):
+        """What in the read options (config.Reading) this law cannot honour, in one line."""
+        if reading.cs > 0.0:
+            return (f"cs = {reading.cs:g}: the volumetric law's shear work is not read; accepted "
+                    "0 with polyhedra on Law2_PolyhedraGeom_PolyhedraPhys_Volumetric")
+        return None
+
+    def young_is_stiffness(self, material):
+        """Whether a YADE material's `young` is this law's kn (N/m3): a PolyhedraMat's is."""
+        return type(material).__name__ == "PolyhedraMat"
+
+    def read(self, reader, interactions, bodies, tracked, zeroed, now, interval, asleep, counts,
+             zeroing_changes):
+        """One read (ContactReader.read), every step: the zeroing does not act on this law."""
+        self.pair_checks.add(interactions, bodies)
+        previous = reader.last_time if reader.last_time is not None else now
+        return read_rows(reader, interactions.all(True), bodies, tracked, now, previous)
+
+    @staticmethod
+    def held(table, row, physs):
+        """Elastic energy (J) contact `row` holds now: the running integral of F d(delta)."""
+        return table.value(row, HELD)
+
+    @staticmethod
+    def neighbour_energy(reader, body, interactions, zeroed_pairs, each=None):
+        """The neighbours (ids) of `body` over `interactions` and the elastic energy (J) its
+        contacts hold, both sides, as the reader's rows integrate it."""
+        found = [i.id2 if i.id1 == body else i.id1 for i in interactions]
+        energy = sum(max(reader.table.value(row, HELD), 0.0)
+                     for row, _ in reader.table.rows_of(body))
+        return found, energy

@@ -1,7 +1,7 @@
 """The protocol of a part that runs in YADE's loop (in the spirit of HOOMD-blue's custom actions
-and LAMMPS fixes): a part says when it acts (its hook in YADE's loop and its period in steps),
-acts, and gives and takes its state, so that one store saves every part with the scene and
-restores it after O.load, in this process or another.
+and LAMMPS fixes): a part says when it acts (its hook in YADE's loop and its trigger: after each
+act, the step it is due next; triggers.py), acts, and gives and takes its state, so that one
+store saves every part with the scene and restores it after O.load, in this process or another.
 
     class Mine(Part):
         kind = "mine"                          # its name in the registry and in O.tags
@@ -11,7 +11,8 @@ restores it after O.load, in this process or another.
         @classmethod
         def from_state(cls, label, period, state): return cls(...)
 
-    install(Mine("mine", period=5))            # after O.engines is set (or into a list of engines)
+    install(Mine("mine", 5))                   # after O.engines is set (or into a list of engines);
+                                               # 5: every 5 steps (or a triggers.Trigger)
 
 Adding a part is one file with its class. One PyRunner per hook point (`yadebreak_<hook>`: just
 before or after the InteractionLoop, or after NewtonIntegrator) calls the parts due there, in the
@@ -30,6 +31,7 @@ import json
 from importlib import import_module
 
 from yadebreak.adapter.yade_api import O, current_scene, find_engine, wrapper
+from yadebreak.engine.parts.triggers import as_trigger
 
 #: where in YADE's loop a part's runner stands
 BEFORE_INTERACTIONS = "before_interactions"
@@ -50,8 +52,10 @@ _MEMBERS: dict[str, tuple] = {}           # hook -> (scene, [(kind, label), ...]
 
 
 class Part:
-    """One piece of work in YADE's loop; `label` names it, `period` its steps; `awake` False: it
-    waits for wake(); `last`: the step it last acted at (None: never)."""
+    """One piece of work in YADE's loop; `label` names it, `trigger` says when it acts (a
+    triggers.Trigger, or an integer k: every k steps); `period`: the steps from its last act to
+    its next, as its trigger last said; `awake` False: it waits for wake(); `last`: the step it
+    last acted at (None: never)."""
 
     kind: str = ""
     hook: str = AFTER_INTERACTIONS
@@ -69,14 +73,19 @@ class Part:
                 raise ValueError(f"part {cls.kind!r}: hook {cls.hook!r}, accepted {HOOKS}")
             _KINDS[cls.kind] = cls
 
-    def __init__(self, label, period=1):
+    def __init__(self, label, trigger=1):
         self.label = label
-        self.period = int(period)
+        self.trigger = as_trigger(trigger)
+        self.period = self.trigger.next_step(0)
         self.awake = True
         self.last = None
 
     def act(self):
         raise NotImplementedError
+
+    def next_step(self, now):
+        """The step the part is due next, asked after it acted at `now` (its trigger's)."""
+        return self.trigger.next_step(now)
 
     def to_state(self, folder=None):
         """The part's state as a JSON-able dict (its period, last step and whether it is awake
@@ -86,6 +95,8 @@ class Part:
 
     @classmethod
     def from_state(cls, label, period, state):
+        """The part restored from its `state` (to_state's), due every `period` steps until its
+        first act."""
         return cls(label, period)
 
     @classmethod
@@ -212,13 +223,17 @@ def live(kind):
 
 
 def run_hook(hook):
-    """Called by a hook's runner: every awake part there whose period has passed acts."""
+    """Called by a hook's runner: every awake part there whose period has passed acts, and its
+    trigger says when it is due next."""
     now = O.iter
     for kind, label in _members(hook):
         part = part_of(kind, label)
         if part.awake and (part.last is None or now - part.last >= part.period):
             part.last = now
             part.act()
+            period = part.next_step(now) - now
+            if period != part.period:
+                _change(label, period=max(1, period))
 
 
 def run(kind, label):
@@ -226,16 +241,34 @@ def run(kind, label):
     part = part_of(kind, label)
     part.last = O.iter
     part.act()
+    _change(label, period=max(1, part.next_step(O.iter) - O.iter))
 
 
-def set_period(label, period):
-    """Part `label` acts every `period` steps from its last step on."""
-    _change(label, period=int(period))
+def set_trigger(label, trigger):
+    """Part `label` acts when `trigger` says (a Trigger, or an integer: every k steps), counted
+    from its last act (a step already past: the next step)."""
+    part = _named(label)
+    if part is None:
+        raise ValueError(f"no yadebreak part labelled {label!r} in this scene")
+    part.trigger = as_trigger(trigger)
+    _change(label, period=_period_after_last(part))
 
 
 def wake(label):
-    """Part `label` acts again (from the next step its period allows)."""
-    _change(label, awake=True)
+    """Part `label` acts again, when its trigger says counted from its last act (a step already
+    past: the next step)."""
+    part = _named(label)
+    if part is None:                                   # not restored (older scenes' own runner)
+        _change(label, awake=True)
+        return
+    _change(label, awake=True, period=_period_after_last(part))
+
+
+def _period_after_last(part):
+    """The steps from the part's last act (now, if it never acted) to the one its trigger
+    says."""
+    last = part.last if part.last is not None else O.iter
+    return max(1, part.next_step(last) - last)
 
 
 def sleep(label):

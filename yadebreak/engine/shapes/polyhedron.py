@@ -1,7 +1,6 @@
-"""Replacing a broken convex polyhedron (a YADE Polyhedra body) by the convex cells it splits
-into (model.cells.fragment_cells at the event's t10'): every cell finer than the smallest
-resolved size, as the spheres' dummy class (X_MIN of the parent's size), goes to the fines
-ledger; the others become Polyhedra bodies of the parent's YADE material. The cells tile the
+"""A convex polyhedron (a YADE Polyhedra body) breaks into the convex cells it splits into
+(model.cells.fragment_cells at the event's t10'): every cell finer than the smallest resolved
+size, as the spheres' dummy class (X_MIN of the parent's size), goes to the fines ledger; the others become Polyhedra bodies of the parent's YADE material. The cells tile the
 parent, so mass and volume are the parent's; each cell moves with the parent's rigid field
 (v + w x r at its centroid, spin w), so momentum, angular momentum and kinetic energy are the
 parent's too (ledger included: its cells' translation in its momenta, their spin in the audit).
@@ -13,8 +12,9 @@ from typing import NamedTuple
 import numpy as np
 
 from yadebreak import model
-from yadebreak.model.cells import fragment_cells, polyhedron_mass_properties
+from yadebreak.model.cells import fragment_cells, polyhedron_mass_properties, sieve_size
 from yadebreak.adapter.yade_api import Matrix3, O, Quaternion, Vector3, wrapper
+from yadebreak.engine.shapes.base import Progeny, Shape
 
 
 class Pose(NamedTuple):
@@ -137,25 +137,28 @@ def cell_body(material, vertices, centroid, mass, velocity, spin, damped):
     return b
 
 
-class CellBreakage:
-    """Breaks convex polyhedra into cells for a Replacer (its state, recipes, ledger, rows)."""
+class Polyhedron(Shape):
+    """YADE's Polyhedra (convex): its size is its sieve size (model.cells.sieve_size: 2 radius
+    is the size of Eq. 3 and of the t10 sieves, as a sphere's diameter is); it breaks into the
+    cells of model.cells.fragment_cells."""
 
-    def __init__(self, replacer):
-        self.replacer = replacer
+    name, plural = "polyhedron", "polyhedra"
+    yade_shape = "Polyhedra"
 
-    def replace(self, bid, t10, dmin, elastic_before, neighbours=()):
-        """Erase polyhedron `bid` and insert its cells for t10' (%). `elastic_before`: the
-        energy (J) its contacts held; `neighbours`: the ids it touched, whose contacts with the
-        cells count work from the state they start in (the reader's inherit). Returns the fields
-        of replacement.Progeny: fragment ids, t10', speed excess, smallest, audit. No contact is
-        made here (elastic_energy_after 0): the collider finds the cells' contacts. They touch
-        face to face: on the volumetric law a shared face makes no force; through
+    def size(self, body):
+        return sieve_size([tuple(v) for v in body.shape.v])
+
+    def replace(self, breaking, body, bid, t10, direction, dmin):
+        """Erase polyhedron `bid` and insert its cells for t10' (%) (Shape.replace; the cells
+        take no direction). The parent's neighbours' contacts with the cells count work from
+        the state they start in (the reader's inherit). No contact is made here
+        (elastic_energy_after 0): the collider finds the cells' contacts. They touch face to
+        face: on the volumetric law a shared face makes no force; through
         Ig2_Polyhedra_Polyhedra_ScGeom they start with an overlap and fly apart
         (docs/polyhedra.md)."""
-        rep = self.replacer
-        table, body = rep.table, O.bodies[bid]
-        label = table.label_of(bid)
-        recipe = rep.recipes[label]
+        rep = breaking
+        neighbours, elastic_before = rep.neighbours(bid)
+        table, label, recipe = rep.table, rep.label, rep.recipe
         mass = float(table.columns["mass"][bid])
         parent_size = 2.0 * float(table.columns["radius"][bid])
         pose = pose_of(body)
@@ -176,7 +179,7 @@ class CellBreakage:
         ids = list(O.bodies.append(new)) if new else []
         rep.reader.inherit([(i, n) for i in ids for n in neighbours])
         radii = 0.5 * cells.sieve_sizes[keep]
-        rep.new_rows(ids, label, np.zeros(len(ids), bool), radii, cells.masses[keep], t10,
+        rep.add_rows(ids, label, np.zeros(len(ids), bool), radii, cells.masses[keep], t10,
                      parent_size, int(table.columns["generation"][bid]) + 1, dmin)
         reach = np.linalg.norm(local, axis=1).max()
         speed = np.linalg.norm(cells.velocities[keep], axis=1).max() if ids else 0.0
@@ -185,7 +188,7 @@ class CellBreakage:
                  "elastic_energy_before": float(elastic_before),
                  "kinetic_energy_after": cells_kinetic_energy(cells, pose.spin),
                  "elastic_energy_after": 0.0}
-        return ids, float(t10), excess, self._smallest(cells, keep, material), audit
+        return Progeny(ids, float(t10), excess, self._smallest(cells, keep, material), audit)
 
     @staticmethod
     def _smallest(cells, keep, material):
