@@ -1,4 +1,5 @@
-"""A ParaView time series of a YADE scene: the spheres with yadebreak's state, walls and facets.
+"""A ParaView time series of a YADE scene: the bodies of each shape that can break (engine/shapes/)
+with yadebreak's state, walls and facets.
 
     frames = ParaviewSeries("out/run/paraview", brk, interval=2e-4)   # writes the first frame
     while running:
@@ -13,7 +14,8 @@ Files (XML VTK in ASCII, so any XML parser reads them; docs/outputs.md lists eve
   polyhedra.pvd, polyhedra_NNNN.vtp   in scenes with polyhedra, from the first frame that has
                                    one: each polyhedron's faces as polygons, each face with its
                                    body's id, volume, velocity, fracture_energy, damage, class
-                                   and generation
+                                   and generation (any other shape: <its plural>.pvd, as its
+                                   Shape.frame draws it)
   surfaces.pvd, surfaces_NNNN.vtp  walls as square patches sized to the bed, facets as triangles;
                                    a new file only when they change (the bed's holder goes at the
                                    first touch), earlier frames name the same file
@@ -29,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from yadebreak.scenes import view
+from yadebreak.engine.shapes import SHAPES
 from yadebreak.engine.state import NONE
 from yadebreak.jobs.lifecycle import write_atomic
 
@@ -79,8 +82,8 @@ class ParaviewSeries:
         self._wall_patch = wall_patch     # (centre, half side), or None until the first frame
         self._sphere_arrays = sphere_arrays
         self._surfaces = None             # ((points, polygons, ids), file) last written
-        self.frames = []                  # (time, spheres file, surfaces file)
-        self.polyhedra_frames = []        # (time, polyhedra file), from the first with one
+        self.frames = []                  # (time, surfaces file)
+        self.shape_frames = {}            # shape plural -> [(time, its file)], from its first
         if resume:
             self._keep_frames_until(view.now())
         else:
@@ -108,49 +111,39 @@ class ParaviewSeries:
         return start + (math.floor((last - start) / self.interval + 1e-9) + 1) * self.interval
 
     def write_frame(self):
-        k = len(self.frames)
-        spheres = f"spheres_{k:04d}.vtp"
-        write_atomic(self.folder / spheres, self._spheres_vtp())
-        surfaces = self._surfaces_file()
-        self.frames.append((float(view.now()), spheres, surfaces))
-        write_atomic(self.folder / "spheres.pvd", _pvd([(t, s) for t, s, _ in self.frames]))
-        write_atomic(self.folder / "surfaces.pvd", _pvd([(t, s) for t, _, s in self.frames]))
-        self._polyhedra_frame(k)
+        k, now = len(self.frames), float(view.now())
+        for shape in SHAPES.values():
+            self._shape_frame(shape, k, now)
+        self.frames.append((now, self._surfaces_file()))
+        write_atomic(self.folder / "surfaces.pvd", _pvd(self.frames))
 
-    def _polyhedra_frame(self, k):
-        """Frame k's polyhedra, once the scene has had one (a sphere scene writes none)."""
-        found = view.polyhedra()
-        if not len(found.ids) and not self.polyhedra_frames:
+    def _shape_frame(self, shape, k, now):
+        """Frame k of one shape's bodies (Shape.frame: one pass over YADE's bodies, the rest in
+        numpy), from the first frame on or from the first that has one (paraview_from_start)."""
+        found = shape.frame(view.bodies())
+        if found is None:
             return
-        name = f"polyhedra_{k:04d}.vtp"
-        columns = self._body_columns(found.ids)
-        arrays = [("id", found.ids, "Int64"), ("volume", found.volume, "Float64"),
-                  ("velocity", found.vel, "Float64"),
-                  ("fracture_energy", columns["fracture_energy"], "Float64"),
-                  ("damage", columns["damage"], "Float64"),
-                  ("class", columns["class"], "Int32"),
-                  ("generation", columns["generation"], "Int32")]
-        per_face = [(name_, np.asarray(values)[found.owner], kind)
-                    for name_, values, kind in arrays]
-        write_atomic(self.folder / name, _polydata(found.points, per_face, "CellData",
-                                                   found.faces))
-        self.polyhedra_frames.append((float(view.now()), name))
-        write_atomic(self.folder / "polyhedra.pvd", _pvd(self.polyhedra_frames))
-
-    # -- spheres ---------------------------------------------------------------------------------
-    def _spheres_vtp(self):
-        ids, pos, vel, radius = view.spheres()  # one pass over YADE's bodies; the rest is numpy
-        arrays = [("id", ids, "Int64"), ("radius", radius, "Float64"),
-                  ("velocity", vel, "Float64")]
-        if self._sphere_arrays is not None:
-            arrays += self._sphere_arrays(ids)
-            return _polydata(pos, arrays, "PointData")
-        columns = self._body_columns(ids)
-        arrays += [("fracture_energy", columns["fracture_energy"], "Float64"),
-                   ("damage", columns["damage"], "Float64"),
-                   ("class", columns["class"], "Int32"),
-                   ("generation", columns["generation"], "Int32")]
-        return _polydata(pos, arrays, "PointData")
+        series = self.shape_frames.setdefault(shape.plural, [])
+        if not len(found.ids) and not series and not shape.paraview_from_start:
+            return
+        name = f"{shape.plural}_{k:04d}.vtp"
+        arrays = [("id", found.ids, "Int64"), *found.arrays, ("velocity", found.vel, "Float64")]
+        if shape.paraview_from_start and self._sphere_arrays is not None:
+            arrays += self._sphere_arrays(found.ids)
+        else:
+            columns = self._body_columns(found.ids)
+            arrays += [("fracture_energy", columns["fracture_energy"], "Float64"),
+                       ("damage", columns["damage"], "Float64"),
+                       ("class", columns["class"], "Int32"),
+                       ("generation", columns["generation"], "Int32")]
+        if found.faces is None:
+            text = _polydata(found.points, arrays, "PointData")
+        else:
+            text = _polydata(found.points, [(n, np.asarray(v)[found.owner], t)
+                                            for n, v, t in arrays], "CellData", found.faces)
+        write_atomic(self.folder / name, text)
+        series.append((now, name))
+        write_atomic(self.folder / f"{shape.plural}.pvd", _pvd(series))
 
     def _body_columns(self, ids):
         """fracture_energy, damage, class and generation of bodies `ids` from the controller's
@@ -179,7 +172,7 @@ class ParaviewSeries:
             if (last_polys == polys and np.array_equal(last_ids, ids)
                     and np.array_equal(last_points, points)):
                 return name
-        name = f"surfaces_{len({s for _, _, s in self.frames}):04d}.vtp"
+        name = f"surfaces_{len({s for _, s in self.frames}):04d}.vtp"
         write_atomic(self.folder / name, _surfaces_vtp(geometry))
         self._surfaces = (geometry, name)
         return name
@@ -225,26 +218,28 @@ class ParaviewSeries:
     # -- resuming ------------------------------------------------------------------------------
     def _keep_frames_until(self, now):
         """Reload the frames of an interrupted run written up to `now` (s); remove later ones."""
-        spheres, surfaces = (_read_pvd(self.folder / name) for name in ("spheres.pvd", "surfaces.pvd"))
-        self.frames = [(t, s, f) for (t, s), (_, f) in zip(spheres, surfaces) if t <= now]
-        self.polyhedra_frames = [(t, f) for t, f in _read_pvd(self.folder / "polyhedra.pvd")
-                                 if t <= now]
-        self._remove_files(len(self.frames), {f for _, _, f in self.frames})
+        self.frames = [(t, f) for t, f in _read_pvd(self.folder / "surfaces.pvd") if t <= now]
+        for shape in SHAPES.values():
+            kept = [(t, f) for t, f in _read_pvd(self.folder / f"{shape.plural}.pvd") if t <= now]
+            if kept:
+                self.shape_frames[shape.plural] = kept
+        self._remove_files(len(self.frames), {f for _, f in self.frames})
         if self.frames:                   # surfaces unchanged since: that file goes on
-            last = self.folder / self.frames[-1][2]
+            last = self.folder / self.frames[-1][1]
             geometry = self._surface_geometry()
             if last.is_file() and last.read_text() == _surfaces_vtp(geometry):
                 self._surfaces = (geometry, last.name)
 
     def _remove_files(self, first_kept_out, surfaces_kept=()):
-        """Frame files of an earlier run not in this series: spheres_k and polyhedra_k for k >=
+        """Frame files of an earlier run not in this series: each shape's frame k for k >=
         first_kept_out and surface files not kept (an older, longer run would otherwise leave
         stray frames)."""
-        for path in [*self.folder.glob("spheres_*.vtp"), *self.folder.glob("polyhedra_*.vtp")]:
-            if int(path.stem.split("_")[1]) >= first_kept_out:
-                path.unlink()
-        if first_kept_out == 0:
-            (self.folder / "polyhedra.pvd").unlink(missing_ok=True)
+        for shape in SHAPES.values():
+            for path in self.folder.glob(f"{shape.plural}_*.vtp"):
+                if int(path.stem.split("_")[1]) >= first_kept_out:
+                    path.unlink()
+            if first_kept_out == 0 and not shape.paraview_from_start:
+                (self.folder / f"{shape.plural}.pvd").unlink(missing_ok=True)
         for path in self.folder.glob("surfaces_*.vtp"):
             if path.name not in surfaces_kept:
                 path.unlink()

@@ -123,8 +123,14 @@ def _named(material):
     return material if isinstance(material, str) else material.source
 
 
-#: the particle shapes of single impacts: the scene builder of each
-SHAPES = ("sphere", "polyhedra")
+def impact_scenes():
+    """The particle shapes of single impacts, each with its scene builder (a new shape's
+    builder is one more entry)."""
+    return {"sphere": impact_scene, "polyhedra": volumetric_impact_scene}
+
+
+#: the particle shapes of single impacts (impact_scenes)
+SHAPES = tuple(impact_scenes())
 
 
 def impact_spec(material, size, speed, particles, per_scene, seed, target="steel",
@@ -185,8 +191,7 @@ def run_scenes(spec, which, event_log=None, on_scene=None, watch=None, materials
                 ran, limited = run_drop_weight(brk, ids, strikers, spec["max_time"])
             brk.finish()
         else:
-            build = (volumetric_impact_scene if spec.get("shape") == "polyhedra"
-                     else impact_scene)
+            build = impact_scenes()[spec.get("shape", "sphere")]
             brk, ids = build(material, spec["size"], [spec["speed"]] * counts[k],
                              target=target, seed=seed, event_log=log_here,
                              **spec["options"])

@@ -9,6 +9,7 @@ import numpy as np
 
 from yadebreak.adapter import yade_api as _yade
 from yadebreak.adapter.yade_api import O, utils, wrapper
+from yadebreak.engine.shapes import SHAPES
 
 
 # -- the clock -----------------------------------------------------------------------------------
@@ -97,54 +98,22 @@ class Spheres(NamedTuple):
     radius: np.ndarray      # (n,) m
 
 
+def bodies():
+    """YADE's bodies of the scene (O.bodies), for the engine's shapes to draw
+    (engine/shapes/: Shape.frame)."""
+    return O.bodies
+
+
 def spheres():
-    """The scene's spheres (Spheres)."""
-    ids, pos, vel, radius = [], [], [], []
-    for b in O.bodies:
-        if b is not None and isinstance(b.shape, wrapper.Sphere):
-            ids.append(b.id)
-            pos.append(tuple(b.state.pos))
-            vel.append(tuple(b.state.vel))
-            radius.append(b.shape.radius)
-    return Spheres(np.array(ids, np.int64), np.array(pos, float).reshape(-1, 3),
-                   np.array(vel, float).reshape(-1, 3), np.array(radius, float))
+    """The scene's spheres (Spheres): their shape's ParaView frame (engine/shapes/sphere.py)."""
+    frame = SHAPES["Sphere"].frame(O.bodies)
+    return Spheres(frame.ids, frame.points, frame.vel, frame.arrays[0][1])
 
 
 def finest_sphere_size():
     """Diameter (m) of the smallest sphere in the scene (nan if none)."""
     radius = spheres().radius
     return float(2.0 * radius.min()) if len(radius) else float("nan")
-
-
-class Polyhedra(NamedTuple):
-    """The scene's polyhedra, in body order: ids, velocities, and each one's faces as polygons
-    over the points of all of them (its vertices where they are now)."""
-    ids: np.ndarray         # (n,)
-    vel: np.ndarray         # (n, 3) m/s
-    volume: np.ndarray      # (n,) m^3
-    points: np.ndarray      # (m, 3) m: every polyhedron's vertices, one after the other
-    faces: list             # [[point index, ...]] every polyhedron's faces, one after the other
-    owner: np.ndarray       # (number of faces,) the index into ids of each face's polyhedron
-
-
-def polyhedra():
-    """The scene's polyhedra (Polyhedra); no polyhedra: empty arrays."""
-    ids, vel, volume, points, faces, owner = [], [], [], [], [], []
-    for b in O.bodies:
-        if b is None or not isinstance(b.shape, wrapper.Polyhedra):
-            continue
-        first = len(points)
-        pos, ori = b.state.pos, b.state.ori
-        points.extend(tuple(pos + ori * v) for v in b.shape.v)
-        for face in b.shape.GetSurfaces():
-            faces.append([first + int(k) for k in face])
-            owner.append(len(ids))
-        ids.append(b.id)
-        vel.append(tuple(b.state.vel))
-        volume.append(b.shape.GetVolume())
-    return Polyhedra(np.array(ids, np.int64), np.array(vel, float).reshape(-1, 3),
-                     np.array(volume, float), np.array(points, float).reshape(-1, 3), faces,
-                     np.array(owner, np.int64))
 
 
 class Surface(NamedTuple):

@@ -3,7 +3,7 @@ progeny), listed in SHAPES by YADE's shape class. Adding a shape to the package 
 with such a class and one line here (docs/architecture.md, "A new shape")."""
 from __future__ import annotations
 
-from yadebreak.engine.shapes.base import Breaking, Progeny, Shape
+from yadebreak.engine.shapes.base import Breaking, Frame, Progeny, Shape
 from yadebreak.engine.shapes.polyhedron import Polyhedron
 from yadebreak.engine.shapes.sphere import Sphere
 
@@ -19,4 +19,4 @@ def shape_of(body):
     return SHAPES.get(type(body.shape).__name__)
 
 
-__all__ = ["Breaking", "Progeny", "SHAPES", "Shape", "shape_of"]
+__all__ = ["Breaking", "Frame", "Progeny", "SHAPES", "Shape", "shape_of"]

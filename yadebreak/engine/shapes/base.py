@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, NamedTuple
+
+import numpy as np
 
 
 @dataclass
@@ -39,16 +41,33 @@ class Breaking:
     add_rows: Callable      # Replacer.new_rows: the fragments' rows in the body table
 
 
+class Frame(NamedTuple):
+    """A shape's bodies as ParaView draws them (jobs/paraview.py), in body order: ids,
+    velocities, and either a point per body (`faces` None: its centre) or polygons over the
+    points (`faces`, lists of point indices; `owner`, the index into ids of each polygon's
+    body); `arrays`, the shape's own per-body values [(name, values, VTK type)] written after
+    the id (a sphere's radius, a polyhedron's volume)."""
+    ids: np.ndarray         # (n,) int64
+    vel: np.ndarray         # (n, 3) m/s
+    points: np.ndarray      # (m, 3) m
+    faces: list = None
+    owner: np.ndarray = None
+    arrays: list = ()
+
+
 class Shape:
-    """A particle shape that can break: its size for Eq. 3 and the t10 sieves, and its
-    replacement by progeny. One instance per shape (no state); SHAPES (shapes/__init__.py)
-    lists them by YADE's shape class."""
+    """A particle shape that can break: its size for Eq. 3 and the t10 sieves, its
+    replacement by progeny, and its bodies as ParaView draws them. One instance per shape (no
+    state); SHAPES (shapes/__init__.py) lists them by YADE's shape class."""
 
     #: its name in jobs and docs, and of many of its bodies
     name = ""
     plural = ""
     #: the YADE Shape class (its name) of its bodies
     yade_shape = ""
+    #: its ParaView series is written from the first frame even with no body of it (the
+    #: spheres': a scene's ball is one); else from the first frame that has one
+    paraview_from_start = False
 
     def size(self, body):
         """The body's size (m): Eq. 3's, and the sieve it passes (2 radius for a sphere)."""
@@ -59,3 +78,8 @@ class Shape:
         normal of its most energetic contact; `dmin` (m): progeny finer than it cannot break.
         Returns a Progeny."""
         raise NotImplementedError
+
+    def frame(self, bodies):
+        """Its bodies among `bodies` (YADE's O.bodies) now, as a Frame; None: the shape is not
+        drawn in ParaView."""
+        return None

@@ -14,7 +14,7 @@ import numpy as np
 from yadebreak import model
 from yadebreak.model.cells import fragment_cells, polyhedron_mass_properties, sieve_size
 from yadebreak.adapter.yade_api import Matrix3, O, Quaternion, Vector3, wrapper
-from yadebreak.engine.shapes.base import Progeny, Shape
+from yadebreak.engine.shapes.base import Frame, Progeny, Shape
 
 
 class Pose(NamedTuple):
@@ -147,6 +147,26 @@ class Polyhedron(Shape):
 
     def size(self, body):
         return sieve_size([tuple(v) for v in body.shape.v])
+
+    def frame(self, bodies):
+        """Each polyhedron's faces as polygons over its vertices where they are now, with its
+        volume."""
+        ids, vel, volume, points, faces, owner = [], [], [], [], [], []
+        for b in bodies:
+            if b is None or not isinstance(b.shape, wrapper.Polyhedra):
+                continue
+            first = len(points)
+            pos, ori = b.state.pos, b.state.ori
+            points.extend(tuple(pos + ori * v) for v in b.shape.v)
+            for face in b.shape.GetSurfaces():
+                faces.append([first + int(k) for k in face])
+                owner.append(len(ids))
+            ids.append(b.id)
+            vel.append(tuple(b.state.vel))
+            volume.append(b.shape.GetVolume())
+        return Frame(np.array(ids, np.int64), np.array(vel, float).reshape(-1, 3),
+                     np.array(points, float).reshape(-1, 3), faces, np.array(owner, np.int64),
+                     [("volume", np.array(volume, float), "Float64")])
 
     def replace(self, breaking, body, bid, t10, direction, dmin):
         """Erase polyhedron `bid` and insert its cells for t10' (%) (Shape.replace; the cells

@@ -10,7 +10,7 @@ from yadebreak import model
 from yadebreak.model import placement
 from yadebreak.adapter.yade_api import O, utils, wrapper
 from yadebreak.engine.contacts.hertz import contact_elastic_energy
-from yadebreak.engine.shapes.base import Progeny, Shape
+from yadebreak.engine.shapes.base import Frame, Progeny, Shape
 
 
 class Sphere(Shape):
@@ -18,9 +18,24 @@ class Sphere(Shape):
 
     name, plural = "sphere", "spheres"
     yade_shape = "Sphere"
+    paraview_from_start = True
 
     def size(self, body):
         return 2.0 * body.shape.radius
+
+    def frame(self, bodies):
+        """A point per sphere, at its centre, with its radius (one pass over the bodies)."""
+        ids, pos, vel, radius = [], [], [], []
+        sphere = wrapper.Sphere
+        for b in bodies:
+            if b is not None and isinstance(b.shape, sphere):
+                ids.append(b.id)
+                pos.append(tuple(b.state.pos))
+                vel.append(tuple(b.state.vel))
+                radius.append(b.shape.radius)
+        return Frame(np.array(ids, np.int64), np.array(vel, float).reshape(-1, 3),
+                     np.array(pos, float).reshape(-1, 3),
+                     arrays=[("radius", np.array(radius, float), "Float64")])
 
     def replace(self, breaking, body, bid, t10, direction, dmin):
         """A sphere's family, coarse fragments across `direction` (Shape.replace)."""
