@@ -235,6 +235,7 @@ class Controller:
         """After the InteractionLoop, when the read schedule says: read -> judge -> log ->
         replace -> time step -> reschedule."""
         state = self.state
+        self.reader.contact_law.settle(O)         # the law's corrections of this step's forces
         if not state.tracked and not state.open_events:
             self.zeroing.forget_changes()         # the next read looks every row up
             self.damping.release()
@@ -316,8 +317,9 @@ class Controller:
                 self.damping.add(progeny.ids)
                 self.schedule.saw_speed(max((O.bodies[i].state.vel.norm() for i in progeny.ids),
                                             default=0.0))
+                step = self.reader.contact_law.fragment_time_step
                 for radius, material in progeny.smallest:
-                    new_dt = min(new_dt, self.time_step.for_fragments(radius, material))
+                    new_dt = min(new_dt, step(self.time_step, radius, material))
             self.record_event("breakage", bid, **event)
         self.time_step.lower(new_dt, self.reader.bodies_in_contact)
         self.wall_time["replace"] += time.perf_counter() - t0

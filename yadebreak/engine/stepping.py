@@ -48,12 +48,14 @@ class TimeStep:
                 f"of the smallest sphere ({rayleigh_time:.3g} s): contacts may go unstable and "
                 f"energies be wrong; use time_step_fraction (0.05 recommended) or lower O.dt"))
 
-    def for_fragments(self, radius, material):
-        """The time step fragments of `radius` (m) need (inf if O.dt stays the user's)."""
-        tr = float(placement.rayleigh_time(radius, material.density, material.young,
-                                           material.poisson))
+    def for_fragments(self, radius, material, modulus, fraction=None):
+        """The time step fragments of `radius` (m) of a YADE `material` need (inf if O.dt stays
+        the user's): time_step_fraction (or the contact law's own `fraction`) of the Rayleigh
+        time with Young's modulus `modulus` (Pa; the law's: contacts/laws.py,
+        fragment_time_step)."""
+        tr = float(placement.rayleigh_time(radius, material.density, modulus, material.poisson))
         if self.fraction:
-            return self.fraction * tr
+            return (fraction or self.fraction) * tr
         self.check(tr)
         return math.inf
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from yadebreak.adapter.yade_api import Matrix3, O, Quaternion, Vector3, utils, wrapper as _w
 from yadebreak.engine import add_materials, attach
+from yadebreak.engine.contacts.volumetric import STEP_FRACTION
 from yadebreak.engine.shapes.polyhedron import skipped_turn
 from yadebreak import model
 from yadebreak.model import placement
@@ -361,11 +362,9 @@ def follow_impact(impact, max_steps=50000, read=True):
 
 
 #: O.dt of a breakage scene of polyhedra on the volumetric law, as a fraction of the Rayleigh time
-#: of a particle's volume-equivalent sphere (with its material file's Young's modulus): a
-#: face-on impact lasts about one such time (kn = E*/size), so this gives it about 100 steps;
-#: measured (tests/test_polyhedra_reading.py), the energy a cube reads at 300 J/kg is then
-#: within 0.1 % of Eq. 4's share face, edge or corner first
-VOLUMETRIC_STEP = 0.01
+#: of a particle's volume-equivalent sphere (with its material file's Young's modulus): the
+#: law's own (engine/contacts/volumetric.py), which the engine keeps for finer fragments
+VOLUMETRIC_STEP = STEP_FRACTION
 
 
 def random_particle(size, rng):

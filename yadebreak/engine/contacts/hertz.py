@@ -37,9 +37,28 @@ class HertzMindlin:
     #: the engine sets O.dt from the Rayleigh time of the smallest breakable body
     time_step_advice = None
 
+    def inherited(self, pairs, zeroed):
+        """Fresh fragments overlap as `pairs`: the zeroing (engine/zeroing.py) holds a sphere
+        fragment's overlaps; nothing of the law's own."""
+
+    def settle(self, scene):
+        """Nothing to correct after the InteractionLoop."""
+
+    def to_dict(self):
+        return {}
+
+    def restore(self, data):
+        pass
+
     def problems(self, reading):
         """What in the read options (config.Reading) this law cannot honour: none."""
         return None
+
+    @staticmethod
+    def fragment_time_step(time_step, radius, material):
+        """The time step (s) fragments of `radius` (m) in a YADE `material` need: time_step_
+        fraction of their Rayleigh time (stepping.TimeStep)."""
+        return time_step.for_fragments(radius, material, material.young)
 
     def young_is_stiffness(self, material):
         """Whether a YADE material's `young` is the law's own stiffness rather than a Young's

@@ -147,10 +147,12 @@ class ContactReader:
 
     # -- saved with the scene ------------------------------------------------------------------
     def to_dict(self):
-        return {**self.table.to_dict(), "inherited": sorted(self.inherited),
+        return {**self.table.to_dict(), **self.contact_law.to_dict(),
+                "inherited": sorted(self.inherited),
                 "last_time": self.last_time}
 
     def restore(self, data):
         self.table.restore(data)
         self.inherited = {tuple(pair) for pair in data.get("inherited", ())}
+        self.contact_law.restore(data)
         self.last_time = data.get("last_time")

@@ -197,7 +197,9 @@ class Polyhedron(Shape):
         new = [cell_body(material, cells.vertices[k], cells.centroids[k], cells.masses[k],
                          cells.velocities[k], pose.spin, recipe.damped) for k in keep]
         ids = list(O.bodies.append(new)) if new else []
-        rep.reader.inherit([(i, n) for i in ids for n in neighbours])
+        pairs = [(i, n) for i in ids for n in neighbours]
+        rep.reader.inherit(pairs)
+        rep.reader.contact_law.inherited(pairs, rep.options.zero_overlaps)
         radii = 0.5 * cells.sieve_sizes[keep]
         rep.add_rows(ids, label, np.zeros(len(ids), bool), radii, cells.masses[keep], t10,
                      parent_size, int(table.columns["generation"][bid]) + 1, dmin)
