@@ -41,6 +41,7 @@ def _follow(out, capsys, said):
     code, error = _bed(out, capsys, **{way.group(1): True})
     assert code == 0, (said, error)
     assert (out / "finished.json").exists() and (out / "summary.json").exists()
+    assert not (out / ".yadebreak.lock").exists()        # a finished run leaves no lock
 
 
 def test_each_state_of_a_run_folder_says_a_way_on_that_works(scene, tmp_path, capsys):

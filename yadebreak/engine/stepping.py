@@ -50,12 +50,12 @@ class TimeStep:
 
     def for_fragments(self, radius, material, modulus, fraction=None):
         """The time step fragments of `radius` (m) of a YADE `material` need (inf if O.dt stays
-        the user's): time_step_fraction (or the contact law's own `fraction`) of the Rayleigh
-        time with Young's modulus `modulus` (Pa; the law's: contacts/laws.py,
+        the user's): time_step_fraction, or the contact law's own `fraction` if smaller, of the
+        Rayleigh time with Young's modulus `modulus` (Pa; the law's: contacts/laws.py,
         fragment_time_step)."""
         tr = float(placement.rayleigh_time(radius, material.density, modulus, material.poisson))
         if self.fraction:
-            return (fraction or self.fraction) * tr
+            return min(fraction or self.fraction, self.fraction) * tr
         self.check(tr)
         return math.inf
 

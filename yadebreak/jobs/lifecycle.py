@@ -124,9 +124,10 @@ def lock_out(out, claim=None):
     if out.exists() and not out.is_dir():
         raise NotADirectoryError(errno.ENOTDIR, "a file, not a folder", str(out))
     key = str(out.resolve())
-    f = None
+    f, made = None, False
     if key not in _LOCKS:                 # (else this process holds it already)
         out.mkdir(parents=True, exist_ok=True)
+        made = not (out / LOCK).exists()
         f = open(out / LOCK, "a+")
         try:
             fcntl.flock(f, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -144,6 +145,8 @@ def lock_out(out, claim=None):
             claim()
     except BaseException:
         if f is not None:
+            if made:                      # a refusal leaves the folder as it was
+                (out / LOCK).unlink(missing_ok=True)
             f.close()
         raise
     if f is None:
@@ -181,7 +184,9 @@ def own_out(out, args):
     (lock_out), a new run over an earlier one refused (claim_out; ScriptError), an --out that
     cannot be written (a file, a read-only or full disk) ended in one line and exit code 1
     before anything runs; on leaving, the lock is released, and a folder the run left holding
-    only its lock is left as it was found (removed if this run made it)."""
+    only its lock is left as it was found (removed if this run made it). A finished run
+    (finished.json) leaves no lock; one that ended otherwise keeps it, the mark of a run that
+    wrote there (run_left_in)."""
     fresh = not Path(out).exists()
     left = None if fresh else run_left_in(out)            # read before our own lock
     try:
@@ -194,7 +199,10 @@ def own_out(out, args):
         yield
     finally:
         if locked:                       # the run is over (a YADE prompt may follow)
-            _LOCKS.pop(str(Path(out).resolve())).close()
+            held = _LOCKS.pop(str(Path(out).resolve()))
+            if (Path(out) / FINISHED).is_file():
+                (Path(out) / LOCK).unlink()        # while held: no other run took this file
+            held.close()
             if [p.name for p in Path(out).iterdir()] == [LOCK]:
                 (Path(out) / LOCK).unlink()        # refused before writing: leave nothing
                 if fresh:

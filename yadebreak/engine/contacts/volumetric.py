@@ -269,8 +269,8 @@ class Volumetric:
 
     def fragment_time_step(self, time_step, radius, material):
         """The time step (s) fragments of `radius` (m) in a YADE `material` need: STEP_FRACTION
-        of the Rayleigh time with the Young's modulus their contacts act with (time_step_
-        fraction is the Hertz law's). A face-on contact of a body of size s on this law
+        (or time_step_fraction, if smaller) of the Rayleigh time with the Young's modulus their
+        contacts act with. A face-on contact of a body of size s on this law
         stiffens as kn s^2 and its mass grows as s^3, so it lasts as sqrt(rho s / kn): as a
         Hertz body of size s and Young's modulus kn (1 - nu^2) s. The scenes set
         kn = Y / (1 - nu^2) / S for particles of size S (scenes/polyhedra.py): at s = S this
