@@ -419,8 +419,29 @@ def test_feed_outside_the_particle_sizes_or_not_a_size_is_refused(tmp_path):
         parse_feed("2 m")
     with pytest.raises(FeedError, match=r"--feed = 0: must be in \[0.001, 1000\] \(mm\)"):
         parse_feed("0")
-    with pytest.raises(FeedError, match="cannot be read"):         # not a length: a file name
-        parse_feed("8 kg")
+    for other in ("8 kg", "5.5km", "5.5kg"):                    # a quantity, not a length
+        with pytest.raises(FeedError, match=rf"--feed = {other}: a size takes a length unit"):
+            parse_feed(other)
+    with pytest.raises(FeedError, match="--feed = abc: neither a size .* nor a CSV file"):
+        parse_feed("abc")
+
+
+@pytest.mark.parametrize("argv, line", [
+    (["--feed", "5.5kg"], "--feed = 5.5kg: a size takes a length unit"),
+    (["--feed", "abc"], "--feed = abc: neither a size"),
+    (["--interval", "20", "--minutes", "1"], "--interval = 20 min: accepted up to --minutes"),
+])
+def test_grind_refuses_nonsense_in_one_line_before_writing(tmp_path, capsys, argv, line):
+    """Every quantity read as one (a unit that is not a length is not a file name), and an
+    interval longer than the grinding: one line, exit 2, no --out left."""
+    from yadebreak.cli import main
+    out = tmp_path / "g"
+    with pytest.raises(SystemExit) as end:
+        main(["grind", "synthetic:30", "--material", "copper_ore", "--feed", "8mm", *argv,
+              "--out", str(out)])
+    err = [l for l in capsys.readouterr().err.splitlines() if "error" in l]
+    assert end.value.code == 2 and len(err) == 1 and line in err[0], err
+    assert not out.exists()
 
 
 def test_grind_on_a_full_disk_ends_in_one_line_and_leaves_whole_files(tmp_path, capsys,

@@ -68,3 +68,24 @@ def test_the_yadebreak_command_runs_debians_python_whichever_comes_first(tmp_pat
     said = subprocess.run([command, "materials"], capture_output=True, text=True, env=env,
                           timeout=120)
     assert said.returncode == 0 and "copper_ore" in said.stdout, said.stderr
+
+
+def _description(said):
+    """The paragraph between a help's usage and its first list of arguments."""
+    lines = said.split("\n\n", 1)[1].split("\n")
+    kept = []
+    for line in lines:
+        if line.startswith(("options:", "positional arguments:")):
+            break
+        kept.append(line)
+    return " ".join(" ".join(kept).split())
+
+
+@pytest.mark.parametrize("command", ["tradeoff", "fit", "verify"])
+def test_a_commands_help_is_whole_and_names_the_yadebreak_command(capsys, command):
+    """A description of several lines ends its sentence (verify's stopped at "at the paper's"),
+    and the program is `yadebreak` (python, python3 and `python3 -m yadebreak` are gone)."""
+    said = _help(capsys, lambda: cli.main([command, "--help"]))
+    text = _description(said)
+    assert text.endswith((".", ")")), text[-80:]
+    assert said.startswith(f"usage: yadebreak {command}") and "python" not in said, said[:300]

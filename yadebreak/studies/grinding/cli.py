@@ -60,17 +60,28 @@ def parse_feed(text_value):
     8mm, '0.008 m') or else a CSV file (size_mm, passing_percent). Returns a size in m or
     (sizes m, passing %)."""
     parts = number_and_unit(text_value)
-    if parts is None or parts[1] not in ("", *UNITS["mm"]):
-        return read_psd_csv(text_value)
-    try:
-        return FEED_SIZE.convert(text_value) * 1e-3
-    except ParamError as exc:
-        raise FeedError(f"{exc} or a CSV file") from None
+    if parts is not None:                  # a quantity: a size, in a length unit
+        if parts[1] not in ("", *UNITS["mm"]):
+            raise FeedError(f"--feed = {text_value}: a size takes a length unit "
+                            f"({', '.join(UNITS['mm'])}; a plain number is in mm), or give a "
+                            "CSV file (size_mm, passing_percent)")
+        try:
+            return FEED_SIZE.convert(text_value) * 1e-3
+        except ParamError as exc:
+            raise FeedError(f"{exc} or a CSV file") from None
+    if not Path(text_value).is_file():
+        raise FeedError(f"--feed = {text_value}: neither a size (a number in mm, or with a length "
+                        "unit: 8mm, '0.008 m') nor a CSV file (size_mm, passing_percent) that "
+                        "exists")
+    return read_psd_csv(text_value)
 
 
 def grind(args):
     """The grind command (registered in yadebreak.cli)."""
     out = Path(args.out)
+    if args.interval > args.minutes:
+        raise FeedError(f"--interval = {args.interval:g} min: accepted up to --minutes "
+                        f"({args.minutes:g} min), the time between outputs of that grinding")
     feed = parse_feed(args.feed)
     material = load_material(args.material)
     out.mkdir(parents=True, exist_ok=True)

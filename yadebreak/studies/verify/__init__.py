@@ -1,4 +1,4 @@
-"""`python3 -m yadebreak verify [--quick 1]`: the paper's Section 4.1 verification at the paper's
+"""`yadebreak verify [--quick 1]`: the paper's Section 4.1 verification at the paper's
 settings, as a Markdown report with one plot per figure (model lines and simulated points side by
 side, each figure's settings printed under it).
 
@@ -61,7 +61,7 @@ from yadebreak.model.materials import MaterialError
 from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import progress, tool_run
 from yadebreak.options.engine_flags import Derived, Override, attach_options, engine_flag
-from yadebreak.options.flags import (integer, jobs_option, numbers, out_option, overwrite_option,
+from yadebreak.options.flags import (flag, integer, jobs_option, numbers, out_option, overwrite_option,
                                      text)
 from yadebreak.studies.verify import energy_audit, fragmentation, probability
 from yadebreak.studies.verify.report import write_report
@@ -107,8 +107,8 @@ def fragmentation_options(args):
 
 
 PARAMS = [
-    integer("quick", 0, "1: the quick subset (copper ore, few particles, 2-3 energies; under 3 "
-            "minutes)", lo=0, hi=1),
+    flag("quick", False, "the quick subset (copper ore, few particles, 2-3 energies; under 3 "
+         "minutes)"),
     text("figures", ",".join(DEFAULT_FIGURES),
          "figures to run, comma-separated: " + ", ".join(FIGURES), empty=False),
     text("materials", ",".join(PAPER_MATERIALS), "materials of Figs. 8 and 16 (names or files)",
@@ -200,7 +200,7 @@ def verify(args):
 def main(argv):
     """Parse `argv` (after `verify`) and run; bad values stop with one line (exit 2)."""
     from yadebreak.options.flags import DEBUG, ScriptParser, add_params, read_params
-    parser = ScriptParser(prog="yadebreak verify", description=__doc__.split("\n")[0])
+    parser = ScriptParser(prog="yadebreak verify", description=__doc__.split("\n\n")[0])
     add_params(parser, PARAMS + [DEBUG])
     args = read_params(parser.parse_args(argv), PARAMS + [DEBUG])
     args.argv = list(argv)
