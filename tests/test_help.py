@@ -89,3 +89,12 @@ def test_a_commands_help_is_whole_and_names_the_yadebreak_command(capsys, comman
     text = _description(said)
     assert text.endswith((".", ")")), text[-80:]
     assert said.startswith(f"usage: yadebreak {command}") and "python" not in said, said[:300]
+
+
+@pytest.mark.yade
+def test_yade_imported_into_plain_python_prints_nothing():
+    """YADE's package prints "Using python version: ..." when imported outside its launcher
+    (extremes.py's stray line): the adapter keeps it off stdout."""
+    said = subprocess.run([PYTHON, "-c", "import yadebreak.adapter.yade_api"], capture_output=True,
+                          text=True, timeout=120, cwd=ROOT)
+    assert said.returncode == 0 and said.stdout == "", said.stdout + said.stderr[-500:]

@@ -1,8 +1,18 @@
 """The one module of yadebreak that imports yade (from Debian's python3 too: see
 yadebreak.adapter.yadepath). The coupling, scenes and runs take YADE's names from here."""
+import contextlib
+import io
+import sys
+
 from yadebreak.adapter.yadepath import ensure_yade_importable
 
 ensure_yade_importable()
+
+if "yade" not in sys.modules:          # imported into plain Python (jobs, tests, verify workers):
+    with contextlib.redirect_stdout(io.StringIO()) as said:     # YADE's package says
+        import yade                    # noqa: F401,E402  "Using python version: ..." on stdout
+    sys.stdout.write("".join(line for line in said.getvalue().splitlines(True)
+                             if not line.startswith("Using python version")))
 
 import yade.wrapper as wrapper  # noqa: E402
 from yade import Matrix3, O, Quaternion, Vector3, geom, utils  # noqa: E402
