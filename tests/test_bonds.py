@@ -217,5 +217,8 @@ def test_the_two_kinds_of_material_file_are_told_apart():
     assert available_materials(kind="bonded_agglomerate") == ["glass_epoxy"]
     with pytest.raises(MaterialError, match="load_agglomerate_material"):
         load_material("glass_epoxy")
-    with pytest.raises(MaterialError, match="kind: must be"):
+    with pytest.raises(MaterialError) as err:          # one line, naming what is accepted
         bonds.load_agglomerate_material("copper_ore")
+    assert err.value.problems == ['a particle material (for the other scripts), not a bonded '
+                                  'agglomerate: accepted a file with kind = "bonded_agglomerate" '
+                                  '(glass_epoxy, or a .toml path)']

@@ -127,12 +127,14 @@ def load_agglomerate_material(name_or_path):
         doc = tomllib.loads(path.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise MaterialError(path, [f"not valid TOML: {exc}"]) from None
+    if doc.get("kind") != "bonded_agglomerate":        # one line, not one per foreign key
+        names = ", ".join(available_materials(kind="bonded_agglomerate"))
+        what = ("a particle material (for the other scripts)" if "breakage" in doc
+                else f"kind = {doc.get('kind')!r}")
+        raise MaterialError(path, [f"{what}, not a bonded agglomerate: accepted a file with "
+                                   f"kind = \"bonded_agglomerate\" ({names}, or a .toml path)"])
     problems = []
     check_keys(doc, {"name", "description", "kind", "spheres", "binder"}, "(top level)", problems)
-    if doc.get("kind") != "bonded_agglomerate":
-        problems.append(f"kind: must be \"bonded_agglomerate\" for an agglomerate material, got "
-                        f"{doc.get('kind')!r} (a replacement-model material is read by "
-                        "load_material)")
     spheres = _section(doc, "spheres", _SPHERE_KEYS, problems)
     binder = _section(doc, "binder", _BINDER_KEYS, problems)
     if None not in (spheres["diameter_min"], spheres["diameter_max"], spheres["diameter_mean"]):
