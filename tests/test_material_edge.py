@@ -1,6 +1,8 @@
 """A job's edge: a material is resolved once (a job's options, attach()), then passed on as an
 object, so a run reads each material file once; a material that cannot serve, or a bed too large
 to build, is refused in one line before anything is written."""
+import argparse
+
 import pytest
 
 from yadebreak.jobs import options as job_options
@@ -63,3 +65,23 @@ def test_a_bed_past_the_largest_is_refused_with_its_count_and_memory(tmp_path, c
     with pytest.raises(SystemExit):
         read(largest + 1)
     assert not (tmp_path / "o").exists()
+
+
+def test_a_mill_past_the_largest_charge_is_refused_with_its_count_and_memory(tmp_path, capsys):
+    """A 5 m drum of 8 mm ore: one line with the balls, the ore particles and the memory, before
+    anything is written; the default mill is accepted."""
+    from yadebreak.model.milling import charge_counts
+    argv = ["--drum-diameter", "5", "--drum-length", "5", "--out", str(tmp_path / "o")]
+    with pytest.raises(SystemExit) as ended:
+        job_options.read("ball_mill", argv=argv)
+    assert ended.value.code == 2
+    line = capsys.readouterr().err.strip()
+    defaults = {p.name: p.default for p in job_options.JOBS["ball_mill"].params()}
+    balls, ore = charge_counts(argparse.Namespace(**{**defaults, "drum_diameter": 5.0,
+                                                     "drum_length": 5.0}))
+    assert balls + ore > job_options.MOST_MILL_BODIES
+    assert f"a charge of {balls:,} balls and {ore:,} ore particles (about " in line
+    assert line.endswith(f"accepted at most {job_options.MOST_MILL_BODIES:,} bodies (a smaller "
+                         "drum, coarser ore or balls, lower fillings)")
+    assert not (tmp_path / "o").exists()
+

@@ -59,12 +59,12 @@ def test_a_short_mill_run_keeps_mass_stays_finite_and_the_motor_does_work(scene,
 
 def test_the_charge_fills_the_drum_as_asked(scene, tmp_path):
     """Fillings are bulk volumes over the drum's volume, the bulk PACKING solid."""
-    from yadebreak.scenes import mill
+    from yadebreak.model import milling
     args = _args(tmp_path)
-    balls, ores = mill.charge_counts(args)
+    balls, ores = milling.charge_counts(args)
     volume = math.pi * 0.06 ** 2 * 0.04
-    assert balls == round(0.3 * volume * mill.PACKING / (math.pi / 6 * 0.015 ** 3))
-    assert ores == round(0.1 * volume * mill.PACKING / (math.pi / 6 * 0.006 ** 3))
+    assert balls == round(0.3 * volume * milling.PACKING / (math.pi / 6 * 0.015 ** 3))
+    assert ores == round(0.1 * volume * milling.PACKING / (math.pi / 6 * 0.006 ** 3))
 
 
 def test_a_resumed_mill_goes_on_from_its_checkpoint_and_refuses_other_arguments(scene, tmp_path):

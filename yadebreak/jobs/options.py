@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from yadebreak.model.intervals import BALL_MASS, elastic_wave_speed
+from yadebreak.model.milling import charge_counts
 from yadebreak.options.engine_flags import (OPTION, Derived, Override, engine_flag,
                                             overrides_markdown)
 from yadebreak.options.engine_flags import attach_options as _attach_options
@@ -155,6 +156,8 @@ def _check_specific_energies(args, option):
 #: about 13 kB at build (measured: 21 MB for 1,639 particles, 75 MB for 6,289), fragments more
 MOST_BED_PARTICLES = 100_000
 BED_BYTES_PER_PARTICLE = 13e3
+#: the largest mill charge a script builds (balls and ore particles), at the bed's memory a body
+MOST_MILL_BODIES = 100_000
 
 
 def _check_bed_size(args):
@@ -244,6 +247,14 @@ def _check_ball_mill(args):
     problem = check_mill_geometry(args)
     if problem:
         fail(problem)
+    balls, ore = charge_counts(args)
+    if balls + ore > MOST_MILL_BODIES:
+        fail(f"--drum-diameter = {args.drum_diameter:g} m, --drum-length = {args.drum_length:g} m, "
+             f"--size = {args.size:g} m, --ball-size = {args.ball_size:g} m: a charge of "
+             f"{balls:,} balls and {ore:,} ore particles (about "
+             f"{(balls + ore) * BED_BYTES_PER_PARTICLE / 1e9:.3g} GB at build); accepted at most "
+             f"{MOST_MILL_BODIES:,} bodies (a smaller drum, coarser ore or balls, lower "
+             "fillings)")
 
 
 def _agglomerate_own():

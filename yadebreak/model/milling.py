@@ -16,6 +16,18 @@ import numpy as np
 
 #: Acceleration of gravity, m/s^2 (the value behind the classical 42.3 / sqrt(D - d) rpm).
 GRAVITY = 9.81
+#: solid fraction of a settled charge (bulk volume -> solid volume)
+PACKING = 0.6
+
+
+def charge_counts(args):
+    """(balls, ore particles) for the fillings: a filling is the bulk volume of the charge over the
+    drum's volume; the bulk is PACKING solid."""
+    volume = math.pi * (0.5 * args.drum_diameter) ** 2 * args.drum_length
+    ball_volume = math.pi / 6 * args.ball_size ** 3
+    ore_volume = math.pi / 6 * args.size ** 3
+    return (max(1, round(args.ball_filling * volume * PACKING / ball_volume)),
+            max(1, round(args.ore_filling * volume * PACKING / ore_volume)))
 
 
 def _scalar_or_array(a):

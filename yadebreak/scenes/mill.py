@@ -15,7 +15,6 @@ from yadebreak.adapter.yade_api import O, utils, wrapper as _w
 from yadebreak.engine.stepping import smallest_rayleigh_time
 from yadebreak.scenes.impacts import hertz_engines
 
-PACKING = 0.6                    # solid fraction of a settled charge (bulk volume -> solid volume)
 SETTLE_TIME = 0.25               # s of settling under gravity, drum still, before the engine
 
 
@@ -84,16 +83,6 @@ def charge_positions(radius, length, clearance, ball_size, balls, ore_size, ores
     return ball_at, ore_at
 
 
-def charge_counts(args):
-    """(balls, ore particles) for the fillings: a filling is the bulk volume of the charge over the
-    drum's volume; the bulk is PACKING solid."""
-    volume = math.pi * (0.5 * args.drum_diameter) ** 2 * args.drum_length
-    ball_volume = math.pi / 6 * args.ball_size ** 3
-    ore_volume = math.pi / 6 * args.size ** 3
-    return (max(1, round(args.ball_filling * volume * PACKING / ball_volume)),
-            max(1, round(args.ore_filling * volume * PACKING / ore_volume)))
-
-
 # -- the scene ----------------------------------------------------------------------------------------
 def mill_scene(args, options, ore_material):
     """Build the mill of the job's `args`, its ore of `ore_material` (a Material), settle the
@@ -106,7 +95,7 @@ def mill_scene(args, options, ore_material):
     profile = drum_profile(radius, args.lifters, args.lifter_height, args.lifter_width)
     drum = O.bodies.append(drum_facets(profile, args.drum_length, "steel"))
     ends = O.bodies.append(end_walls(args.drum_length, "steel"))
-    n_balls, n_ore = charge_counts(args)
+    n_balls, n_ore = milling.charge_counts(args)
     rng = np.random.default_rng(args.seed)
     ball_at, ore_at = charge_positions(radius, args.drum_length, args.lifter_height,
                                        args.ball_size, n_balls, args.size, n_ore, rng)
