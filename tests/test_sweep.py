@@ -111,7 +111,7 @@ def test_a_table_runs_on_two_workers(tmp_path):
     table, out = _table(tmp_path), tmp_path / "out"
     proc = _sweep(table, SCRIPT, "--out", out, "--scheduler", "local:2")
     assert proc.returncode == 1, proc.stderr[-2000:]             # a line failed
-    assert "dashboard http" in proc.stdout
+    assert "dashboard http" in proc.stderr                       # progress: stderr
     status = {r["description"]: r for r in json.loads((out / "sweep.json").read_text())["lines"]}
     assert {d: r["state"] for d, r in status.items()} == {
         "cu_a": "done", "cu_b": "done", "bad_energy": "failed", "cu_c": "done"}
@@ -195,7 +195,7 @@ def test_a_killed_sweep_resumes_keeping_the_lines_done(tmp_path):
     stamps = {d: os.stat(out / d / "summary.json").st_mtime_ns for d in done}
     again = _sweep(table, SCRIPT, "--out", out, "--scheduler", "local:2")
     assert again.returncode == 0, again.stdout + again.stderr
-    assert f"{5 - len(done)} of 5 lines to run ({len(done)} done before)" in again.stdout
+    assert f"{5 - len(done)} of 5 lines to run ({len(done)} done before)" in again.stderr
     rows = {r["description"]: r for r in json.loads(status_file.read_text())["lines"]}
     assert all(r["state"] == "done" for r in rows.values())
     for d in done:                                            # not run again
@@ -203,7 +203,7 @@ def test_a_killed_sweep_resumes_keeping_the_lines_done(tmp_path):
         assert rows[d]["attempts"] == 1
     # a third call has nothing to do
     third = _sweep(table, SCRIPT, "--out", out)
-    assert third.returncode == 0 and "all 5 lines" in third.stdout
+    assert third.returncode == 0 and "all 5 lines" in third.stderr
 
 
 def test_another_table_in_the_same_folder_is_refused(tmp_path):

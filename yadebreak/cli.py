@@ -17,11 +17,11 @@ from typing import NamedTuple
 import numpy as np
 
 from yadebreak.model import families
-from yadebreak.jobs.lifecycle import LOCK, save_figure, tool_run, write_atomic
+from yadebreak.jobs.lifecycle import LOCK, save_figure, status, tool_run, write_atomic
 from yadebreak import model
 from yadebreak.model.materials import MaterialError, available_materials
 from yadebreak.criteria import load_material
-from yadebreak.options.flags import (DEBUG, ScriptParser, add_params, fail, integer,
+from yadebreak.options.flags import (COMMON, ScriptParser, add_params, fail, integer,
                                      join_negative_values, number, out_option, overwrite_option,
                                      read_params, text)
 
@@ -119,14 +119,14 @@ def sweep(args):
     from yadebreak.studies import sweep as sw
     options = _key_values(args.jobqueue, "--jobqueue")
     try:
-        status = sw.run_sweep(args.table, args.script, args.out, scheduler=args.scheduler,
-                              retries=args.retries, jobqueue_options=options, jobs=args.jobs,
-                              say=lambda m: print(f"[yadebreak] {m}", flush=True))
+        lines = sw.run_sweep(args.table, args.script, args.out, scheduler=args.scheduler,
+                             retries=args.retries, jobqueue_options=options, jobs=args.jobs,
+                             say=lambda m: print(f"[yadebreak] {m}", flush=True), tell=status)
     except sw.SweepError as exc:
         fail(str(exc))
     except KeyboardInterrupt:
         raise SystemExit(130) from None
-    return sw.main_exit_code(status)
+    return sw.main_exit_code(lines)
 
 
 def gather(args):
@@ -332,8 +332,8 @@ def main(argv=None):
         p = sub.add_parser(name, help=command.help, description=command.help)
         for arg, arg_help in command.positional:
             p.add_argument(arg, help=arg_help)
-        add_params(p, command.params + [DEBUG])
-        p.set_defaults(func=command.run, params=command.params + [DEBUG])
+        add_params(p, command.params + COMMON)
+        p.set_defaults(func=command.run, params=command.params + COMMON)
     every = [p for command in COMMANDS.values() for p in command.params]
     args = parser.parse_args(join_negative_values(argv, every))
     read_params(args, args.params)

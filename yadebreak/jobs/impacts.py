@@ -22,8 +22,8 @@ from yadebreak.scenes import view
 from yadebreak.analysis import reports
 from yadebreak.criteria import load_material
 from yadebreak.jobs import paraview, skeleton
-from yadebreak.jobs.lifecycle import (ScriptError, progress, resume_arguments, save_figure,
-                                       time_left, write_atomic)
+from yadebreak.jobs.lifecycle import (Heartbeat, Remaining, ScriptError, progress,
+                                       resume_arguments, save_figure, write_atomic)
 from yadebreak.jobs import options as job_options
 
 
@@ -78,21 +78,30 @@ def _impacts_at(args, mat, target, k, energy, out, start, pool=None):
     """The particles fired at `energy` (J/kg) in scenes of --scene-particles, by the workers
     `pool` if any: (the last scene's controller, the energy's result)."""
     speed = float(np.sqrt(2 * energy))
-    began, said = time.time(), [time.time()]
+    counts = scenes.scene_counts(args.particles, args.scene_particles)
+    seen = {"done": 0, "tally": None}
+    in_process = pool is None and not scenes.workers_for(args.jobs, counts)
+    remaining = Remaining()
 
     def on_scene(done, scenes_total, tally):
-        now = time.time()
-        if now - said[0] > 5.0 and done < scenes_total:
-            said[0] = now
-            progress(f"{energy:g} J/kg: scene {done}/{scenes_total}, {len(tally.broken)} of "
-                     f"{tally.particles} broken, {tally.breakage_events} breakages, "
-                     f"{time_left(now - began, done / scenes_total)} at this energy")
+        seen["done"], seen["tally"] = done, tally
 
-    tally, brk = scenes.single_impacts(
-        mat, args.size, speed, args.particles, args.scene_particles, args.seed + k,
-        target=target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
-        jobs=args.jobs, pool=pool, shape=args.shape, watch=_frames(args, out, energy),
-        **job_options.attach_options("single_impact", args))
+    def describe(elapsed_s):
+        """The energy's line every few seconds, also inside one long scene."""
+        tally, done = seen["tally"], seen["done"]
+        broken = (f", {len(tally.broken)} of {tally.particles} broken, "
+                  f"{tally.breakage_events} breakages" if tally is not None else "")
+        running = (f", scene {done + 1} at {1e6 * view.now():.4g} us simulated"
+                   if in_process and done < len(counts) else "")
+        return (f"{energy:g} J/kg: {done}/{len(counts)} scenes done{broken}{running}, "
+                f"{elapsed_s:.0f} s, {remaining(elapsed_s, done / len(counts))} at this energy")
+
+    with Heartbeat(describe):
+        tally, brk = scenes.single_impacts(
+            mat, args.size, speed, args.particles, args.scene_particles, args.seed + k,
+            target=target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
+            jobs=args.jobs, pool=pool, shape=args.shape, watch=_frames(args, out, energy),
+            **job_options.attach_options("single_impact", args))
     share = mat.energy_partition(target)
     result = reports.breakage_result_of(tally, mat, energy, target)
     intact = [e for e in tally.first if e["kind"] == "damage"]

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from yadebreak.model.intervals import InputError
 
-from yadebreak.options.flags import debugging, fail, script_option_names
+from yadebreak.options.flags import debugging, fail, quiet, script_option_names
 from yadebreak.process.errors import disk_full, error_line, first_line
 from yadebreak.process.files import (append_whole, save_figure, write_atomic,  # noqa: F401
                                      write_whole)
@@ -381,8 +381,71 @@ def warnings_shown_once():
 
 
 def progress(message):
-    """One line of progress, flushed at once (long runs print these)."""
+    """One line of what a run did (results, outputs written) on stdout, flushed at once."""
     print(f"[yadebreak] {message}", flush=True)
+
+
+def status(message):
+    """One progress line of a long run on stderr, flushed at once; none with --quiet 1."""
+    if not quiet():
+        print(f"[yadebreak] {message}", file=sys.stderr, flush=True)
+
+
+#: a long run says how it goes at least this often (s of wall time), on stderr
+STATUS_EVERY = 10.0
+
+
+class Remaining:
+    """The time a run has left, as a steady estimate: elapsed (1 - done) / done at each call,
+    smoothed (an exponential average with weight 0.3 on the newest, the older counted down by the
+    wall time since), so that a scene that ends early or late moves it by a third of the
+    change, not all of it."""
+
+    def __init__(self):
+        self.left, self.at = None, None
+
+    def __call__(self, elapsed_s, done):
+        """'about N s left' (time_left's words) for `done` (0-1) of the work after `elapsed_s`."""
+        text = time_left(elapsed_s, done)
+        if not text.startswith("about"):
+            return text
+        estimate = max(elapsed_s, 0.0) * (1.0 - done) / done
+        if self.left is not None:
+            estimate = 0.7 * max(self.left - (elapsed_s - self.at), 0.0) + 0.3 * estimate
+        self.left, self.at = estimate, elapsed_s
+        return f"about {estimate:.0f} s left"
+
+
+class Heartbeat:
+    """While a block runs, `describe(elapsed_s)`'s line on stderr every STATUS_EVERY s (status):
+    a thread, which runs while YADE's O.run waits in C++; none with --quiet 1. For a block whose
+    own steps are too long to report between (one long scene)."""
+
+    def __init__(self, describe, every=None):
+        import threading
+        self.describe, self.every = describe, every
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._beat, daemon=True)
+
+    def _beat(self):
+        began = time.time()
+        every = self.every if self.every is not None else STATUS_EVERY
+        while not self._stop.wait(every):
+            try:
+                status(self.describe(time.time() - began))
+            except Exception:            # a line missed, never the run
+                pass
+
+    def __enter__(self):
+        if not quiet():
+            self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        if self._thread.is_alive():
+            self._thread.join()
+        return False
 
 
 def time_left(elapsed_s, done):
@@ -401,7 +464,7 @@ def resume_arguments(args):
     material options): what a resumed run must share with the one it continues."""
     return {k: v for k, v in sorted(vars(args).items())
             if k not in ("resume", "overwrite", "out", "stop_after", "checkpoint_every",
-                         "vtk_interval", "debug", "jobs", "materials")}
+                         "vtk_interval", "debug", "quiet", "jobs", "materials")}
 
 
 def check_resume_arguments(saved, args, path):

@@ -29,10 +29,10 @@ import math
 import time
 from pathlib import Path
 
-from yadebreak.jobs.lifecycle import (CHECKPOINT, PartialResults, check_not_finished,
-                                       check_resume_arguments, mark_finished, mark_started,
-                                       partial_outputs_on_failure, progress, read_checkpoint,
-                                       stop_point, stop_points, time_left)
+from yadebreak.jobs.lifecycle import (CHECKPOINT, PartialResults, Remaining,
+                                       check_not_finished, check_resume_arguments, mark_finished,
+                                       mark_started, partial_outputs_on_failure, progress,
+                                       read_checkpoint, status, stop_point, stop_points)
 
 
 class Job:
@@ -48,6 +48,7 @@ class Job:
         self.args = args
         self.out = Path(args.out)
         self.say = (lambda message: None) if quiet else progress
+        self.quiet = quiet
 
     # -- start ----------------------------------------------------------------------------------
     def check(self):
@@ -176,7 +177,7 @@ def _loop(job, start, runtime):
     args, path = job.args, job.out / CHECKPOINT
     every = getattr(args, "checkpoint_every", job.checkpoint_every)
     stop_after = getattr(args, "stop_after", 0.0)
-    last_report = start
+    last_report, remaining = start, Remaining()
     last_checkpoint = -math.inf           # the first at the first safe point: seconds in, a run
     #                                       killed early goes on from there
 
@@ -196,8 +197,9 @@ def _loop(job, start, runtime):
             return None
         now = time.time()
         if now - last_report > job.report_every:
-            job.say(f"{job.status()}, wall {now - start:.0f} s, "
-                    f"{time_left(now - start, job.done())}")
+            if not job.quiet:
+                status(f"{job.status()}, wall {now - start:.0f} s, "
+                       f"{remaining(now - start, job.done())}")
             last_report = now
 
 

@@ -49,6 +49,7 @@ UNITS = {
 _NUMBER_THEN_UNIT = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)\s*$")
 _TRUE, _FALSE = ("1", "true", "yes", "on"), ("0", "false", "no", "off")
 _DEBUG = False                  # --debug 1: tracebacks instead of one-line errors
+_QUIET = False                  # --quiet 1: no progress lines
 _SCRIPT_OPTIONS = set()         # the running script's option names (warnings name them)
 
 
@@ -300,6 +301,10 @@ def jobs_option(help):
 
 
 DEBUG = flag("debug", False, "show the traceback of an error instead of its one line")
+QUIET = flag("quiet", False, "no progress lines on stderr (results, warnings and errors still "
+             "show)")
+#: the flags every script and command takes
+COMMON = [DEBUG, QUIET]
 
 
 # options that the impact scripts share, declared once
@@ -374,9 +379,10 @@ def add_params(parser, params):
 def read_params(namespace, params):
     """Check and convert every value of `namespace` declared in `params` (in place); a bad one
     ends the program with its one line (exit 2), or raises it with --debug 1."""
-    global _DEBUG
+    global _DEBUG, _QUIET
     try:
         _DEBUG = DEBUG.convert(getattr(namespace, "debug", False))
+        _QUIET = QUIET.convert(getattr(namespace, "quiet", False))
         for p in params:
             setattr(namespace, p.name, p.convert(getattr(namespace, p.name)))
     except ParamError as exc:
@@ -409,7 +415,7 @@ def script_params(params, description=None, argv=None, table_row=None):
     pass coupling.yade_api.table_row: this module never imports YADE)."""
     if isinstance(params, dict):
         params = _from_defaults(params)
-    params = [p for p in params if p.name != "debug"] + [DEBUG]
+    params = [p for p in params if p.name not in ("debug", "quiet")] + COMMON
     _SCRIPT_OPTIONS.clear()
     _SCRIPT_OPTIONS.update(p.name for p in params)
     if os.environ.get("YADE_BATCH"):
@@ -440,6 +446,11 @@ def script_params(params, description=None, argv=None, table_row=None):
 def debugging():
     """True if the running script was given --debug 1 (tracebacks instead of one-line errors)."""
     return _DEBUG
+
+
+def quiet():
+    """True if the running script or command was given --quiet 1 (no progress lines)."""
+    return _QUIET
 
 
 def script_option_names():

@@ -271,15 +271,17 @@ def connect(spec, jobqueue_options=None, jobs=1):
 
 # -- the sweep ----------------------------------------------------------------------------------
 def run_sweep(table, script, out, scheduler="local", retries=1, jobqueue_options=None, jobs=1,
-              say=print, yade="yade"):
+              say=print, yade="yade", tell=None):
     """Run every line of `table` not done yet in `out`, as Dask tasks (run_jobs); then gather
-    sweep.csv. Returns the SweepStatus."""
+    sweep.csv. Returns the SweepStatus. say(line): the outcome; tell(line): the progress on
+    the way (default: say)."""
     table, script, out = Path(table).resolve(), Path(script).resolve(), Path(out).resolve()
     if not script.is_file():
         raise SweepError(f"script {script}: no such file")
     lines = read_table(table)
     status = run_jobs([table_job(line, table, script, out, yade) for line in lines], out,
-                      (str(table), str(script)), scheduler, retries, jobqueue_options, jobs, say)
+                      (str(table), str(script)), scheduler, retries, jobqueue_options, jobs,
+                      tell or say)
     gather(out, lines)
     failed = [d for d, row in status.rows.items() if row["state"] == "failed"]
     say(f"sweep: {status.count('done')} of {len(lines)} lines done, {len(failed)} failed; "

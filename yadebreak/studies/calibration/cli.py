@@ -14,7 +14,7 @@ from yadebreak.model.materials import MaterialError
 from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import write_atomic
 from yadebreak.jobs.lifecycle import tool_run
-from yadebreak.options.flags import (DEBUG, ScriptParser, add_params, fail, out_option,
+from yadebreak.options.flags import (COMMON, ScriptParser, add_params, fail, out_option,
                                      overwrite_option, read_params)
 from yadebreak.studies.calibration import data, outputs
 from yadebreak.studies.calibration.fit import apply_bootstrap, bootstrap, fit_all
@@ -35,7 +35,7 @@ def parser():
     p.add_argument("--bootstrap", default="0", help="bootstrap replicates for the intervals "
                    "(0: profile likelihood; default 0)")
     p.add_argument("--seed", default="1", help="seed of the bootstrap resampling (default 1)")
-    add_params(p, [overwrite_option(), DEBUG])
+    add_params(p, [overwrite_option(), *COMMON])
     return p
 
 
@@ -47,7 +47,7 @@ def _whole(text, option, lo):
 
 def main(argv=None):
     args = parser().parse_args(sys.argv[1:] if argv is None else argv)
-    read_params(args, [out_option(None), overwrite_option(), DEBUG])
+    read_params(args, [out_option(None), overwrite_option(), *COMMON])
     replicates = _whole(args.bootstrap, "bootstrap", 0)
     seed = _whole(args.seed, "seed", 0)
     if not args.name.replace("_", "").replace("-", "").isalnum():

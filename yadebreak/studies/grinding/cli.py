@@ -14,7 +14,7 @@ import numpy as np
 
 from yadebreak.model.intervals import PARTICLE_SIZE
 from yadebreak.criteria import load_material
-from yadebreak.jobs.lifecycle import progress, save_figure, write_atomic
+from yadebreak.jobs.lifecycle import progress, save_figure, status, write_atomic
 from yadebreak.options.flags import UNITS, ParamError, number, number_and_unit
 from yadebreak.studies.grinding.classes import (FeedError, class_label, feed_masses, feed_top_sieve, read_psd_csv,
                       root2_classes)
@@ -105,7 +105,7 @@ def grind(args):
              f"{spectra.rates_per_s.sum():.4g} collisions/s), {classes.count} classes from "
              f"{class_label(classes.sieves[0])} mm")
     result = grinder.run(masses, fines, times, residence_time_s=residence,
-                         progress=lambda t, wall: progress(
+                         progress=lambda t, wall: status(
                              f"t = {t / 60:.2f} of {args.minutes:g} min, wall {wall:.0f} s"))
     s0 = grinder.initial_rates(masses, fines, net=True)
     summary = _write(out, args, material, spectra_path, spectra, classes, result, s0, holdup)

@@ -199,9 +199,9 @@ def verify(args):
 
 def main(argv):
     """Parse `argv` (after `verify`) and run; bad values stop with one line (exit 2)."""
-    from yadebreak.options.flags import DEBUG, ScriptParser, add_params, read_params
+    from yadebreak.options.flags import COMMON, ScriptParser, add_params, read_params
     parser = ScriptParser(prog="yadebreak verify", description=__doc__.split("\n\n")[0])
-    add_params(parser, PARAMS + [DEBUG])
-    args = read_params(parser.parse_args(argv), PARAMS + [DEBUG])
+    add_params(parser, PARAMS + COMMON)
+    args = read_params(parser.parse_args(argv), PARAMS + COMMON)
     args.argv = list(argv)
     return verify(args)

@@ -11,7 +11,7 @@ import numpy as np
 
 from yadebreak.criteria import load_material
 from yadebreak.analysis import reports
-from yadebreak.jobs.lifecycle import progress
+from yadebreak.jobs.lifecycle import progress, status
 from yadebreak.options.engine_flags import OPTION, Override
 
 #: the paper's single-particle verification (its Section 3)
@@ -264,7 +264,7 @@ def _waiting(run, energy):
     began = time.time()
 
     def line(started, submitted):
-        progress(f"waiting for {run.material} {1e3 * run.size:g} mm {energy:g} J/kg: "
+        status(f"waiting for {run.material} {1e3 * run.size:g} mm {energy:g} J/kg: "
                  f"{started} of {submitted} scenes of the command started "
                  f"({time.time() - began:.0f} s)")
     return line
