@@ -123,7 +123,7 @@ def test_a_tables_unknown_column_is_named_in_one_line(monkeypatch, capsys):
     said = capsys.readouterr()
     assert _the_error_line(said.out + said.err) == (
         "[yadebreak] error: the table's column 'nosuch' is not an option of this script (its "
-        "options: debug, size)")
+        "options: debug, quiet, size)")
 
 
 @pytest.mark.parametrize("text_value, minutes", [("10", 10.0), ("90s", 1.5), ("90 s", 1.5),

@@ -19,7 +19,7 @@ from yadebreak.model.intervals import BALL_MASS, elastic_wave_speed
 from yadebreak.model.milling import charge_counts
 from yadebreak.options.engine_flags import (OPTION, Derived, Override, engine_flag,
                                             overrides_markdown)
-from yadebreak.options.engine_flags import attach_options as _attach_options
+from yadebreak.options.engine_flags import options_from_flags
 from yadebreak.options.table import options_markdown
 from yadebreak.options.flags import (checkpointed_run_options, choice, fail, flag, integer,
                                      jobs_option, material_option, number, numbers, out_option,
@@ -44,9 +44,9 @@ class JobOptions:
     def params(self):
         return [*self.own(), *(engine_flag(n, self.overrides) for n in self.engine), *self.run()]
 
-    def attach_options(self, args, **more):
+    def engine_options(self, args, **more):
         """attach()'s options from the parsed `args`, then `more` (the run's own)."""
-        return _attach_options(args, self.engine, self.overrides, **more)
+        return options_from_flags(args, self.engine, self.overrides, **more)
 
 
 # -- blocks that several jobs share (besides flags' material, size, out, ...) ------------------
@@ -356,7 +356,7 @@ JOBS = {
 def attach_options(job, args, **more):
     """attach()'s options of `job` (a key of JOBS) from its parsed `args`, then `more` (the
     run's own: event_log, ...): the one translation from flags to engine options."""
-    return JOBS[job].attach_options(args, **more)
+    return JOBS[job].engine_options(args, **more)
 
 
 #: script options added since a checkpoint could have been written, at the value that gives the

@@ -5,7 +5,7 @@ attach() options. No yade import.
 
     OVERRIDES = {"read_period": Override("every_step", "laboratory tests are the exact reference")}
     params = [engine_flag("read_period", OVERRIDES), engine_flag("dmin", OVERRIDES)]
-    options = attach_options(args, ("read_period", "dmin"), OVERRIDES, event_log="...")
+    options = options_from_flags(args, ("read_period", "dmin"), OVERRIDES, event_log="...")
 
 On a command line None is written as the row's token ("material", "forever", or 0 where 0 lies
 outside the range): `--global-damping material` is the files' damping, `--global-damping 0` none.
@@ -99,7 +99,7 @@ def engine_value(name, value, overrides, args):
     return value
 
 
-def attach_options(args, flags, overrides, **more):
+def options_from_flags(args, flags, overrides, **more):
     """The attach() options of a job: those it exposes as `flags` (names) from `args` (a flag
     absent from `args` takes its default), its `overrides` without a flag, then `more` (the
     run's own: event_log, ...)."""

@@ -60,7 +60,7 @@ from pathlib import Path
 from yadebreak.model.materials import MaterialError
 from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import progress, tool_run
-from yadebreak.options.engine_flags import Derived, Override, attach_options, engine_flag
+from yadebreak.options.engine_flags import Derived, Override, engine_flag, options_from_flags
 from yadebreak.options.flags import (flag, integer, jobs_option, numbers, out_option, overwrite_option,
                                      text)
 from yadebreak.studies.verify import energy_audit, fragmentation, probability
@@ -102,8 +102,8 @@ OVERRIDES = {
 
 def fragmentation_options(args):
     """attach() options of the fragmentation figures from the command's flags."""
-    return attach_options(args, FRAGMENTATION,
-                          {k: o for k, o in OVERRIDES.items() if k in FRAGMENTATION})
+    return options_from_flags(args, FRAGMENTATION,
+                              {k: o for k, o in OVERRIDES.items() if k in FRAGMENTATION})
 
 
 PARAMS = [
