@@ -223,3 +223,24 @@ print("calls", protocol.live("test_saved_counter")["counted"].calls)
                               timeout=120)
         assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.split()[-2:] == ["calls", "10"]           # 5 before the save, 5 after
+
+
+def test_the_engines_runner_waits_as_long_as_its_read_schedule_says(scene):
+    """read_period "auto" sets k after the first read (0.5 of the smallest body's Rayleigh time,
+    O.dt 0.05 of it: k = 10): the runner after the InteractionLoop then runs every k steps, YADE
+    doing the waiting, not every step to find that nothing is due."""
+    from yade import utils
+    from yadebreak import scenes
+    from yadebreak.engine import add_materials, attach, run_steps
+    from yadebreak.engine.parts import protocol
+    O = scene
+    ip2, _ = add_materials({"ore": "copper_ore"})
+    O.bodies.append(utils.sphere((0, 0, 0), 1e-3, material="ore"))
+    O.bodies.append(utils.sphere((0, 0, 3e-3), 1e-3, material="ore"))
+    O.engines = scenes.hertz_engines(ip2)
+    brk = attach({"ore": "copper_ore"}, read_period="auto", read_fraction=0.5)   # k = 10
+    runner = next(e for e in O.engines
+                  if getattr(e, "label", "") == protocol.runner_label(protocol.AFTER_INTERACTIONS))
+    run_steps(400)
+    assert brk.period > 1 and runner.iterPeriod == brk.period
+    assert runner.nDone <= 1 + 400 // brk.period + 1

@@ -39,14 +39,6 @@ class BreakageEngine(protocol.Part):
         self.controller = controller
         super().__init__(label, controller.schedule)
 
-    @property
-    def period(self):
-        return self.controller.schedule.period
-
-    @period.setter
-    def period(self, steps):
-        self.controller.schedule.period = steps
-
     @classmethod
     def tag_for(cls, label):
         return _TAG + label                  # the key every saved scene holds
