@@ -120,7 +120,7 @@ def read_rows(reader, real, bodies, tracked, now, previous):
     if index is None:
         index = dict(zip(zip(table.a.tolist(), table.b.tolist()), range(len(table.a))))
     old_rows, old_geoms, old_physs = table.row_lists(), table.geoms, table.physs
-    a_list, b_list, rows, geoms, physs = [], [], [], [], []
+    kept = []                                         # (a, b, row, geom, phys) of each row
     energy, found, grew, by_body, new_index = {}, {}, set(), {}, {}
     for inter in real:
         a, b = inter.id1, inter.id2
@@ -138,13 +138,8 @@ def read_rows(reader, real, bodies, tracked, now, previous):
             row, geom, phys = old_rows[j], old_geoms[j], old_physs[j]
         if advance(row, geom, phys, bodies[a].state, bodies[b].state, now):
             grew.update(i for i, mine in ((a, in_a), (b, in_b)) if mine)
-        k = len(rows)
-        new_index[(a, b)] = k
-        rows.append(row)
-        a_list.append(a)
-        b_list.append(b)
-        geoms.append(geom)
-        physs.append(phys)
+        k = new_index[(a, b)] = len(kept)
+        kept.append((a, b, row, geom, phys))
         total = total_work(row[WORK], row[SHEAR_WORK], cs)
         for body, other, mine, offset, share, sign in ((a, b, in_a, OFFSET_A, SHARE_A, 1.0),
                                                        (b, a, in_b, OFFSET_B, SHARE_B, -1.0)):
@@ -156,6 +151,8 @@ def read_rows(reader, real, bodies, tracked, now, previous):
                 energy[body] = energy.get(body, 0.0) + own
                 if own > found.get(body, (0.0,))[0]:
                     found[body] = (own, k, sign, other)
+    a_list, b_list, rows, geoms, physs = ((list(c) for c in zip(*kept)) if kept
+                                         else ([], [], [], [], []))
     table.set(np.array(a_list, np.int64), np.array(b_list, np.int64), None, geoms, physs, rows=rows,
               by_body=by_body, index=new_index)
     return Loading(energy, StrongestContacts(found, geoms), grew)
