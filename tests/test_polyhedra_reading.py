@@ -79,10 +79,11 @@ def test_held_plus_kinetic_energy_is_the_energy_fired_closer_at_a_finer_step():
 
 def test_a_cube_broken_on_the_plate_creates_no_energy():
     """3000 J/kg face first: it breaks on the plate into cells that overlap the plate as it did
-    (each overlap the zero of its contact: see the next test), and its cells break again. Each breakage leaves the kinetic energy as it was, no cell faster
-    than the parent's rigid motion at its centroid; to the end of the cascade, the kinetic energy
-    of the bodies plus the ledger's never exceeds the energy fired by more than the integration
-    error measured above (3 %), and the mass is the cube's to round-off."""
+    (each overlap the zero of its contact: see the next test), and its cells break again. Each
+    breakage leaves the kinetic energy as it was, no cell faster than the parent's rigid motion
+    at its centroid; to the end of the cascade, the kinetic energy of the bodies plus the
+    ledger's never exceeds the energy fired by more than the integration error measured above
+    (3 %), and the mass is the cube's to round-off."""
     from yade import O, utils
     brk, cid, energy = _cube_on_plate("face", 3000.0, 0.01)
     mass = O.bodies[cid].state.mass

@@ -7,9 +7,10 @@
 One read, in the order controller.py moves it: contacts/ reads YADE's interactions into each
 tracked body's loading; judging.py asks each body's criterion (yadebreak.criteria) which break;
 replacement.py (with each shape's strategy, shapes/) and zeroing.py put the progeny in;
-stepping.py sets the time step, reads.py the next read; tracking.py keeps which bodies are read; state.py holds bodies, events and the fines
-ledger; scene.py attaches it all and saves it with the scene; materials.py makes YADE materials
-from material files; parts/ holds rolling friction and bond watching. The names below that need
+stepping.py sets the time step, reads.py the next read; tracking.py keeps which bodies are read;
+state.py holds bodies, events and the fines ledger; scene.py attaches it all and saves it with
+the scene; materials.py makes YADE materials from material files; parts/ holds rolling friction
+and bond watching. The names below that need
 YADE import it on first use.
 """
 from importlib import import_module

@@ -12,7 +12,7 @@ import numpy as np
 
 from yadebreak import model
 from yadebreak.adapter.yade_api import O
-from yadebreak.engine.shapes import Breaking, Progeny, shape_of  # noqa: F401 (Progeny: its home)
+from yadebreak.engine.shapes import Breaking, shape_of
 from yadebreak.engine.state import BREAKABLE, DUMMY, UNBREAKABLE
 
 

@@ -80,7 +80,7 @@ def _impacts_at(args, mat, target, k, energy, out, start, pool=None):
     speed = float(np.sqrt(2 * energy))
     counts = scenes.scene_counts(args.particles, args.scene_particles)
     seen = {"done": 0, "tally": None}
-    in_process = pool is None and not scenes.workers_for(args.jobs, counts)
+    in_process = pool is None          # _workers made a pool wherever there are workers
     remaining = Remaining()
 
     def on_scene(done, scenes_total, tally):

@@ -13,6 +13,7 @@ import math
 import os
 import signal
 import sys
+import threading
 import time
 import traceback
 import warnings
@@ -406,10 +407,9 @@ class Remaining:
 
     def __call__(self, elapsed_s, done):
         """'about N s left' (time_left's words) for `done` (0-1) of the work after `elapsed_s`."""
-        text = time_left(elapsed_s, done)
-        if not text.startswith("about"):
-            return text
-        estimate = max(elapsed_s, 0.0) * (1.0 - done) / done
+        estimate = seconds_left(elapsed_s, done)
+        if estimate is None:
+            return UNKNOWN_LEFT
         if self.left is not None:
             estimate = 0.7 * max(self.left - (elapsed_s - self.at), 0.0) + 0.3 * estimate
         self.left, self.at = estimate, elapsed_s
@@ -422,7 +422,6 @@ class Heartbeat:
     own steps are too long to report between (one long scene)."""
 
     def __init__(self, describe, every=None):
-        import threading
         self.describe, self.every = describe, every
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._beat, daemon=True)
@@ -448,14 +447,23 @@ class Heartbeat:
         return False
 
 
-def time_left(elapsed_s, done):
-    """'about N s left' after `elapsed_s` (s) of wall time with the fraction `done` of the work
-    done; 'time left unknown' until 5 % is done (too early to extrapolate). Never negative or nan:
-    `done` is taken within [0, 1]."""
+UNKNOWN_LEFT = "time left unknown"
+
+
+def seconds_left(elapsed_s, done):
+    """The wall time (s) left after `elapsed_s` with the fraction `done` of the work done; None
+    until 5 % is done (too early to extrapolate). Never negative or nan: `done` is taken within
+    [0, 1]."""
     done = min(max(float(done), 0.0), 1.0) if math.isfinite(done) else 0.0
     if done < 0.05 or not math.isfinite(elapsed_s):
-        return "time left unknown"
-    return f"about {max(elapsed_s, 0.0) * (1.0 - done) / done:.0f} s left"
+        return None
+    return max(elapsed_s, 0.0) * (1.0 - done) / done
+
+
+def time_left(elapsed_s, done):
+    """'about N s left' (seconds_left), or 'time left unknown'."""
+    left = seconds_left(elapsed_s, done)
+    return UNKNOWN_LEFT if left is None else f"about {left:.0f} s left"
 
 
 def resume_arguments(args):

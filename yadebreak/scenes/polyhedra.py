@@ -72,8 +72,8 @@ def polyhedron(vertices, material, position=(0.0, 0.0, 0.0), velocity=(0.0, 0.0,
     `material`, its centroid at `position`. YADE re-centres the shape on its centroid, turns it
     to its principal axes and gives its volume and inertia exactly; mass and inertia are those
     times the density. `fixed`: every degree of freedom blocked (a plate). Not appended.
-    A small body, whose turn to its principal axes YADE skips (engine.shapes.polyhedron.skipped_turn),
-    is given to YADE in them."""
+    A small body, whose turn to its principal axes YADE skips
+    (engine.shapes.polyhedron.skipped_turn), is given to YADE in them."""
     mat = _material(material)
     pts = np.asarray(vertices, dtype=float)
     centred = pts - convex_polyhedron(pts).centroid

@@ -39,7 +39,7 @@ class HertzMindlin:
 
     def inherited(self, pairs, zeroed):
         """Fresh fragments overlap as `pairs`: the zeroing (engine/zeroing.py) holds a sphere
-        fragment's overlaps; nothing of the law's own."""
+        fragment's overlaps; nothing of the law's own (ContactReader.inherit)."""
 
     def settle(self, scene):
         """Nothing to correct after the InteractionLoop."""

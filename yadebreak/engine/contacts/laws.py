@@ -16,10 +16,3 @@ def laws_in(functor_names):
     names of an InteractionLoop's Law2 functors), in the order of LAWS."""
     return [law() for law in LAWS if law.yade_law in functor_names]
 
-
-def law_named(name):
-    """A fresh instance of the law `name` (a law's `name`)."""
-    for law in LAWS:
-        if law.name == name:
-            return law()
-    raise ValueError(f"law = {name!r}: accepted {', '.join(repr(law.name) for law in LAWS)}")

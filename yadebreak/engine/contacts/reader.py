@@ -137,10 +137,14 @@ class ContactReader:
         its interactions; the rows' objects would keep their last numbers)."""
         self.erased_bodies.add(body)
 
-    def inherit(self, pairs):
+    def inherit(self, pairs, zeroed=False):
         """Pairs (ids) that fresh fragments inherit overlapping: their rows, made at the next
-        read, count work from that state on (arrays.ArrayRead._start_here)."""
+        read, count work from that state on (arrays.ArrayRead._start_here); `zeroed`: the
+        replacement's zero_overlaps, which the contact law applies where the zeroing does not
+        (laws.py: inherited)."""
+        pairs = list(pairs)
         self.inherited.update((a, b) if a < b else (b, a) for a, b in pairs)
+        self.contact_law.inherited(pairs, zeroed)
 
     def bodies_in_contact(self):
         return set(np.concatenate((self.table.a, self.table.b)).tolist())

@@ -18,8 +18,8 @@ the normal direction), in HELD. OVERLAP holds the approach since the contact beg
 Read every step (Volumetric.reads_every_step: between reads the approach is extrapolated from
 the velocities of one instant), contact by contact (read_rows, calling fresh() and advance() for
 each). A fragment's overlaps inherited from its parent are zeroed (ZeroedVolumes), as a sphere
-fragment's are (engine/zeroing.py). Volumetric is what the reader and the replacer ask of this law (laws.py lists the laws).
-Duck-typed on YADE's objects; no yade import.
+fragment's are (engine/zeroing.py). Volumetric is what the reader and the replacer ask of this
+law (laws.py lists the laws). Duck-typed on YADE's objects; no yade import.
 """
 from __future__ import annotations
 
@@ -77,7 +77,6 @@ def advance(row, geom, phys, state_a, state_b, now):
     return False
 
 
-
 class PairChecks:
     """What YADE's warning "Unhandled switch case:0, function do_intersect" would count. Its
     Ig2_Polyhedra_Polyhedra_PolyhedraGeom tests each pair of polyhedra whose bounding boxes
@@ -109,7 +108,6 @@ class PairChecks:
                     separated += 1
         self.count += separated + len(touching - self.touching)
         self.touching = touching
-
 
 
 def read_rows(reader, real, bodies, tracked, now, previous):
@@ -163,12 +161,14 @@ class ZeroedVolumes:
     the force of such a pair is kn (V - V0), not YADE's kn V, so that only later loading makes
     force (the energy the parent's contacts held went into breaking it; kept, a fine cell deep in
     its parent's overlap with the plate would take the parent's force and pass its own fracture
-    energy many times over within a step). V0 is the pair's volume when YADE first makes it
-    (after the replacement), and follows V down as the bodies separate; a pair is dropped when V0
-    reaches 0 or the interaction ends. The correction is made after the InteractionLoop, before
-    the read: YADE applied F = kn V along the normal at the contact point (-F on id1, +F on id2);
-    kn V0 of it is taken back from both bodies' forces and torques and from phys.normalForce, which
-    the read and the law's next step see."""
+    energy many times over within a step). V0 is the pair's volume when YADE makes it, the step
+    after the replacement, and follows V down as the bodies separate; a pair is dropped when V0
+    reaches 0 or the interaction ends, or at once if YADE did not make it (that neighbour did not
+    overlap the fragment: most of the pairs of a cell and its parent's neighbours). The
+    correction is made after the InteractionLoop, before the read: YADE applied F = kn V along
+    the normal at the contact point (-F on id1, +F on id2); kn V0 of it is taken back from both
+    bodies' forces and torques and from phys.normalForce, which the read and the law's next step
+    see."""
 
     def __init__(self):
         self.volumes = {}                     # (smaller id, larger id) -> V0 (m3), None: not
@@ -186,9 +186,8 @@ class ZeroedVolumes:
                 del self.volumes[pair]
                 continue
             inter = interactions[a, b] if interactions.has(a, b) else None
-            if inter is None or not inter.isReal:
-                if zero is not None:          # it ended; not made yet: wait for it
-                    del self.volumes[pair]
+            if inter is None or not inter.isReal:       # ended, or never overlapped
+                del self.volumes[pair]
                 continue
             volume = inter.geom.penetrationVolume
             zero = volume if zero is None else min(zero, volume)

@@ -1,9 +1,10 @@
 """A convex polyhedron (a YADE Polyhedra body) breaks into the convex cells it splits into
 (model.cells.fragment_cells at the event's t10'): every cell finer than the smallest resolved
-size, as the spheres' dummy class (X_MIN of the parent's size), goes to the fines ledger; the others become Polyhedra bodies of the parent's YADE material. The cells tile the
-parent, so mass and volume are the parent's; each cell moves with the parent's rigid field
-(v + w x r at its centroid, spin w), so momentum, angular momentum and kinetic energy are the
-parent's too (ledger included: its cells' translation in its momenta, their spin in the audit).
+size, as the spheres' dummy class (X_MIN of the parent's size), goes to the fines ledger; the
+others become Polyhedra bodies of the parent's YADE material. The cells tile the parent, so
+mass and volume are the parent's; each cell moves with the parent's rigid field (v + w x r at
+its centroid, spin w), so momentum, angular momentum and kinetic energy are the parent's too
+(ledger included: its cells' translation in its momenta, their spin in the audit).
 """
 from __future__ import annotations
 
@@ -197,9 +198,7 @@ class Polyhedron(Shape):
         new = [cell_body(material, cells.vertices[k], cells.centroids[k], cells.masses[k],
                          cells.velocities[k], pose.spin, recipe.damped) for k in keep]
         ids = list(O.bodies.append(new)) if new else []
-        pairs = [(i, n) for i in ids for n in neighbours]
-        rep.reader.inherit(pairs)
-        rep.reader.contact_law.inherited(pairs, rep.options.zero_overlaps)
+        rep.reader.inherit([(i, n) for i in ids for n in neighbours], rep.options.zero_overlaps)
         radii = 0.5 * cells.sieve_sizes[keep]
         rep.add_rows(ids, label, np.zeros(len(ids), bool), radii, cells.masses[keep], t10,
                      parent_size, int(table.columns["generation"][bid]) + 1, dmin)

@@ -61,8 +61,8 @@ from yadebreak.model.materials import MaterialError
 from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import progress, tool_run
 from yadebreak.options.engine_flags import Derived, Override, engine_flag, options_from_flags
-from yadebreak.options.flags import (flag, integer, jobs_option, numbers, out_option, overwrite_option,
-                                     text)
+from yadebreak.options.flags import (flag, integer, jobs_option, numbers, out_option,
+                                     overwrite_option, text)
 from yadebreak.studies.verify import energy_audit, fragmentation, probability
 from yadebreak.studies.verify.report import write_report
 from yadebreak.studies.verify.settings import (PAPER_MATERIALS, Runner,  # noqa: F401
