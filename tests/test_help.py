@@ -52,6 +52,7 @@ def test_help_of_the_module_and_of_tradeoff_and_gather_sweep_as_run():
     said = subprocess.run([PYTHON, "-m", "yadebreak", "tradeoff", "--help"], capture_output=True,
                           text=True, timeout=120, cwd=ROOT).stdout
     assert "with a 95 %\ninterval" in said                 # its usage's % as written
+    assert "--quiet" in said                                # progress on stderr, silenced
 
 
 def test_the_yadebreak_command_runs_debians_python_whichever_comes_first(tmp_path):

@@ -23,7 +23,7 @@ from yadebreak.model.materials import MaterialError, available_materials
 from yadebreak.criteria import load_material
 from yadebreak.options.flags import (COMMON, ScriptParser, add_params, fail, integer,
                                      join_negative_values, number, out_option, overwrite_option,
-                                     read_params, text)
+                                     QUIET, read_params, text)
 
 
 def _plt():
@@ -141,7 +141,7 @@ def gather(args):
 
 TRADEOFF_USAGE = """yadebreak tradeoff SCRIPT [script options] --vary NAME=V1,V2,...
     [--vary ...] --seeds N --metrics KEY,KEY,... --out DIR [--reference NAME=V,...]
-    [--scheduler SPEC] [--retries N]
+    [--scheduler SPEC] [--retries N] [--quiet 0|1]
 
 Runs SCRIPT over the grid of the varied options x seeds 1..N (the same seeds for every variant),
 one Dask task per run (as `sweep`), reads each run's summary.json and writes DIR/tradeoff.csv,
@@ -167,6 +167,7 @@ def tradeoff_command(argv):
     parser.add_argument("--reference", default="", help="NAME=V,... (default: the slowest)")
     parser.add_argument("--scheduler", default="local", help="as for sweep; default local")
     parser.add_argument("--retries", default="1", help="as for sweep; default 1")
+    parser.add_argument(QUIET.flag, dest=QUIET.name, default="0", help=QUIET.help_line)
     args, script_args = parser.parse_known_args(argv)
     numbers = {}
     for name in ("seeds", "retries"):
@@ -180,7 +181,8 @@ def tradeoff_command(argv):
         to.run(args.script, script_args, varied, numbers["seeds"],
                [m.strip() for m in args.metrics.split(",") if m.strip()], args.out,
                reference_text=args.reference, scheduler=args.scheduler,
-               retries=numbers["retries"], say=lambda m: print(f"[yadebreak] {m}", flush=True))
+               retries=numbers["retries"], say=lambda m: print(f"[yadebreak] {m}", flush=True),
+               tell=status)
     except (to.TradeoffError, SweepError) as exc:
         fail(str(exc))
     except KeyboardInterrupt:

@@ -8,9 +8,9 @@ arguments checked against this run's, then job.resume(); a run that left no chec
 again); calls job.advance() until it says how the run ended, writing a checkpoint at the first
 safe point and then every --checkpoint-every s of wall time and stopping at
 SIGINT or SIGTERM (checkpointed) at the job's safe points; ends as if killed at --stop-after
-(tests); prints a progress line with the time left every job.report_every s; on a failure
-writes the outputs so far with their end reason; at the end writes the outputs, the finish
-marker, and removes the checkpoint.
+(tests); prints a progress line with the time left every job.report_every s, from a thread, so
+also within a long chunk; on a failure writes the outputs so far with their end reason; at the
+end writes the outputs, the finish marker, and removes the checkpoint.
 
     class Drop(Job):
         def build(self): ...                    # the scene, new
@@ -29,10 +29,12 @@ import math
 import time
 from pathlib import Path
 
-from yadebreak.jobs.lifecycle import (CHECKPOINT, PartialResults, Remaining,
+from contextlib import nullcontext
+
+from yadebreak.jobs.lifecycle import (CHECKPOINT, Heartbeat, PartialResults, Remaining,
                                        check_not_finished, check_resume_arguments, mark_finished,
                                        mark_started, partial_outputs_on_failure, progress,
-                                       read_checkpoint, status, stop_point, stop_points)
+                                       read_checkpoint, stop_point, stop_points)
 
 
 class Job:
@@ -177,30 +179,32 @@ def _loop(job, start, runtime):
     args, path = job.args, job.out / CHECKPOINT
     every = getattr(args, "checkpoint_every", job.checkpoint_every)
     stop_after = getattr(args, "stop_after", 0.0)
-    last_report, remaining = start, Remaining()
+    remaining = Remaining()
     last_checkpoint = -math.inf           # the first at the first safe point: seconds in, a run
     #                                       killed early goes on from there
 
     def save():
         job.save(path, runtime())
 
-    while True:
-        ended = job.advance()
-        if ended is not None:
-            return ended
-        if job.at_safe_point():
-            if every >= 0 and time.time() - last_checkpoint >= every:
-                save()                            # --resume 1 goes on from here
-                last_checkpoint = time.time()
-            stop_point(save)                      # SIGINT, SIGTERM: end here, checkpointed
-        if stop_after and job.elapsed() >= stop_after:
-            return None
-        now = time.time()
-        if now - last_report > job.report_every:
-            if not job.quiet:
-                status(f"{job.status()}, wall {now - start:.0f} s, "
-                       f"{remaining(now - start, job.done())}")
-            last_report = now
+    def line(_):
+        wall = time.time() - start
+        return f"{job.status()}, wall {wall:.0f} s, {remaining(wall, job.done())}"
+
+    # the progress line from a thread, also while one chunk of a large scene runs
+    beat = (Heartbeat(line, job.report_every)
+            if math.isfinite(job.report_every) and not job.quiet else nullcontext())
+    with beat:
+        while True:
+            ended = job.advance()
+            if ended is not None:
+                return ended
+            if job.at_safe_point():
+                if every >= 0 and time.time() - last_checkpoint >= every:
+                    save()                            # --resume 1 goes on from here
+                    last_checkpoint = time.time()
+                stop_point(save)                      # SIGINT, SIGTERM: end here, checkpointed
+            if stop_after and job.elapsed() >= stop_after:
+                return None
 
 
 def run_units(args, keys, compute, write, limited=None, validate=None):

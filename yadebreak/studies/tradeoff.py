@@ -326,9 +326,10 @@ def plot_pareto(rows, metrics, path, title):
 
 # -- the driver ------------------------------------------------------------------------------------
 def run(script, script_args, varied, seeds, metrics, out, reference_text="", scheduler="local",
-        retries=1, say=print, yade="yade"):
+        retries=1, say=print, yade="yade", tell=None):
     """Run the grid x seeds through the sweep runner, read the metrics, write the outputs.
-    Returns the rows."""
+    Returns the rows. say(line): the outcome; tell(line): the progress on the way (default:
+    say)."""
     script, out = Path(script).resolve(), Path(out).resolve()
     if not script.is_file():
         raise TradeoffError(f"script {script}: no such file")
@@ -352,7 +353,7 @@ def run(script, script_args, varied, seeds, metrics, out, reference_text="", sch
             where[(variant, seed)] = name
     identity = ("tradeoff " + json.dumps([v.name for v in variants]) + f" seeds {seeds}",
                 str(script) + " " + " ".join(script_args))
-    status = sweep.run_jobs(jobs, out, identity, scheduler, retries, say=say)
+    status = sweep.run_jobs(jobs, out, identity, scheduler, retries, say=tell or say)
     failed = [d for d, row in status.rows.items() if row["state"] != "done"]
     if failed:
         first = status.rows[failed[0]]
