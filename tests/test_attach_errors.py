@@ -144,6 +144,33 @@ def test_energy_jumping_past_the_fracture_energy_warns_once_with_the_remedy(
     assert f"read every {read_period} step(s)" in message
 
 
+@pytest.mark.parametrize("emin", [1e-4, 0.0])
+def test_a_body_below_emin_breaks_on_its_first_count_and_the_warning_names_emin(
+        scene, recwarn, emin):
+    """A 5.5 mm copper ore sphere (0.24 g) at 2 m/s on steel, read every step, its fracture
+    energy a fifth of emin / m: with the paper's emin (1e-4 J) its contact counts only from emin
+    on, so it breaks on that first count at several times its fracture energy; the warning says
+    so and names emin, not a late read. With emin = 0 it breaks at the crossing (within one
+    step's rise, under 1 + LATE_JUMP) and nothing is said."""
+    from yadebreak import scenes
+    from yadebreak.engine.judging import LATE_JUMP
+    brk, ids = scenes.impact_scene("copper_ore", 5.5e-3, [2.0], read_period=1,
+                                   time_step_fraction=0.05, replace=False, emin=emin)
+    body = brk.bodies[ids[0]]
+    body.fracture_energy = 0.2 * 1e-4 / body.mass
+    scenes.run_until_rebound(ids)
+    said = [str(w.message) for w in recwarn.list if "yadebreak:" in str(w.message)]
+    late = [m for m in said if "between two reads" in m]
+    first = [m for m in said if "first counted energy" in m]
+    [event] = brk.breakage_events
+    assert not late
+    if emin:
+        assert event["ratio"] > 1.0 + LATE_JUMP
+        assert len(first) == 1 and "lower emin" in first[0]
+    else:
+        assert 1.0 < event["ratio"] < 1.0 + LATE_JUMP and not first
+
+
 def _unchanged(O):
     """What attach changes in a scene: a refusal must leave all of it as it was."""
     return (O.dt, [type(e).__name__ for e in O.engines], len(O.materials),

@@ -19,6 +19,7 @@ from yadebreak.adapter.yade_api import O, silence_polyhedra_pair_checks, utils
 from yadebreak.engine.contacts import ContactReader, Strongest
 from yadebreak.engine.safeguards import LargeOverlaps
 from yadebreak.criteria import criterion_for
+from yadebreak.engine.breaks_past import BreaksPast
 from yadebreak.engine.judging import Judge, Rules
 from yadebreak.engine.replacement import Recipe, Replacer
 from yadebreak.engine.state import BREAKABLE, BROKEN, UNBREAKABLE, EngineState, assembled_columns
@@ -101,6 +102,9 @@ class Controller:
                                       self.tracking.reach_now if fast else None,
                                       every_step=law.reads_every_step)
         self.time_step = TimeStep(config.time_step.time_step_fraction, self.warn_once)
+        #: O.dt follows the loading where reads cannot come closer (stepping.TimeStep)
+        self.step_follows_loading = bool(law.reads_every_step
+                                         and config.time_step.time_step_fraction)
         gd = config.time_step.global_damping        # None: each material file's
         self.damping = FragmentDamping(
             {lab: (gd if gd is not None else mat.global_damping)
@@ -110,8 +114,9 @@ class Controller:
         rules = Rules(config.criteria.fragments_energy_factor, config.reading.fast_tolerance,
                       config.criteria.break_at == "peak", any(self.pause_steps.values()),
                       config.replacement.contact_energy_at_break == "carried")
+        told = BreaksPast(self.state, self.criteria, self.schedule, self.reader, self.warn_once)
         self.judge = Judge(self.state, self._criterion_of, self.reader, rules,
-                           record=self.record_event, warn_jump=self._warn_jump,
+                           record=self.record_event, warn_jump=told.jump, warn_emin=told.emin,
                            weakened=self.tracking.weakened)
         self.large_overlaps = (LargeOverlaps(config.replacement.overlap_factor)
                                if config.replacement.overlap_factor else None)
@@ -238,6 +243,8 @@ class Controller:
         self.reader.contact_law.settle(O)         # the law's corrections of this step's forces
         if not state.tracked and not state.open_events:
             self.zeroing.forget_changes()         # the next read looks every row up
+            if self.step_follows_loading:
+                self.time_step.follow(None, self.reader.bodies_in_contact)
             self.damping.release()
             self.last_iter = O.iter               # nothing can break: next to no cost
             return
@@ -247,31 +254,18 @@ class Controller:
                                    O.time, interval, self.zeroing.asleep,
                                    utils.numIntrsOfEachBody, self.zeroing.take_changes())
         self.wall_time["read"] += time.perf_counter() - t0
-        broken, limits = self.judge.judge(loading, interval, O.iter, self.schedule.mode == "fast")
+        follow = self.step_follows_loading
+        broken, limits = self.judge.judge(loading, interval, O.iter,
+                                          follow or self.schedule.mode == "fast")
         if self.large_overlaps is not None:
             broken = broken + self.large_overlaps.due(self, loading, broken)
         if broken:
             self._break_all(broken)
+        if follow:
+            self.time_step.follow(limits, self.reader.bodies_in_contact)
         self.damping.release()
         self.last_iter = O.iter
         self.schedule.after_read(limits)
-
-    def _warn_jump(self, bid, rise, scale, ek):
-        """A body broke (or an unbreakable fragment was stressed past its fracture energy) after
-        its energy rose by `rise` (J/kg) between two reads, more than LATE_JUMP of its fracture
-        energy `scale`: its t10' is that of the read, where reading at the crossing gives the
-        criterion's t10' at its threshold (Eq. 8 at Ek'/(m E) = 1; Eq. 9.4 at e_cum = its
-        threshold). The message says both."""
-        table = self.state.table
-        crit = self.criteria[table.label_of(bid)]
-        ratio, t10, _ = crit.breakage(table, bid, ek)
-        low = crit.t10_at_threshold(table, bid, scale)
-        self.warn_once("jump", (
-            f"specific energy rose by {100 * rise / scale:.0f} % of the fracture energy between "
-            f"two reads at body {bid} (read every {self.schedule.period} step(s) of {O.dt:.3g} s): "
-            f"its t10' is {t10:.2f} % (at {ratio:.2f} times its fracture energy) where a read at "
-            f"the crossing gives {low:.2f} %"),
-            remedies=self.schedule.remedies(), purpose="for an accurate t10'")
 
     def record_event(self, kind, bid, **fields):
         """Log an event of body `bid` now (its radius and mass added)."""

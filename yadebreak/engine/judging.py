@@ -73,10 +73,12 @@ def _within(mask, active):
 class Judge:
     """Judges the bodies a read found loaded (or with an open event), and tells `record(kind,
     id, **fields)` of each event, `warn_jump(id, rise, threshold, Ek')` of a read that came
-    late, `weakened(id)` of each body a damage weakened."""
+    late, `warn_emin(id, rise, threshold, Ek', start)` of a body that broke on a contact's first
+    counted energy (`start`, J/kg: see first_count), `weakened(id)` of each body a damage
+    weakened."""
 
     def __init__(self, state, criterion_of, reader, rules, *, record=_ignore, warn_jump=_ignore,
-                 weakened=_ignore):
+                 warn_emin=_ignore, weakened=_ignore):
         self.state = state
         self.criterion_of = criterion_of          # material index -> criterion
         self.reader = reader                      # contacts.ContactReader
@@ -86,6 +88,7 @@ class Judge:
         self.carried = rules.carried
         self.fast_tolerance = rules.fast_tolerance
         self.record, self.warn_jump, self.weakened = record, warn_jump, weakened
+        self.warn_emin = warn_emin
         #: up to this many candidates a read is judged body by body (plan_each)
         self.small = min([SMALL, *(c.judged_one_by_one for c in criterion_of)])
 
@@ -230,7 +233,11 @@ class Judge:
             elif what == BREAK:
                 jump, threshold = float(plan.jump[k]), float(plan.threshold[k])
                 if jump > LATE_JUMP * threshold:
-                    self.warn_jump(i, jump, threshold, float(plan.ek[k]))
+                    start = self.first_count(i, loading)
+                    if jump - start > LATE_JUMP * threshold:
+                        self.warn_jump(i, jump, threshold, float(plan.ek[k]))
+                    else:
+                        self.warn_emin(i, jump, threshold, float(plan.ek[k]), start)
                 broken.append((i, float(plan.ek[k]), loading.strongest.get(i)))
             elif what == PAUSE:
                 # Rocky's safeguard: a fresh fragment counts nothing yet, and what its contacts
@@ -241,6 +248,18 @@ class Judge:
             else:
                 open_events.discard(i)
         return broken
+
+    def first_count(self, i, loading):
+        """The specific energy (J/kg) body i's count rises by, at the least, when its strongest
+        contact at this read is first counted: its share (Eq. 4) of emin, a contact's energy
+        counting only from emin on (the paper's Emin). So much of a rise no closer read removes:
+        a body whose fracture energy is below it breaks on that contact's first count."""
+        at = loading.strongest.row(i)
+        if at is None:
+            return 0.0
+        row, side = at
+        share = self.reader.table.value(row, side)
+        return self._specific(i, share * self.reader.emin, self.state.table.columns)[1]
 
     def _unloaded(self, candidates, plan, loading):
         """The bodies whose event may close that unloaded: none of their contacts worked and

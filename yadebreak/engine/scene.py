@@ -244,7 +244,8 @@ def _state(ctl, folder=None):
         "iter": O.iter, "last_read": ctl.last_iter, "runs": _runs(ctl.label),
         "state": ctl.state.to_dict(),
         "contacts": ctl.reader.to_dict(), "zeroed": ctl.zeroing.to_list(),
-        "damped_until": ctl.damping.until, "fast": ctl.schedule.to_list()}
+        "damped_until": ctl.damping.until, "fast": ctl.schedule.to_list(),
+        "time_step": ctl.time_step.to_list()}
 
 
 def _close_remote_access():
@@ -280,6 +281,7 @@ def _restore(label, data, period):
     own = find_engine(label)                  # a PyRunner of its own (older scenes)
     ctl.schedule.period = own.iterPeriod if own is not None else period
     ctl.schedule.restore(data["fast"])
+    ctl.time_step.restore(data.get("time_step", (None, None)))
     ctl.reader.restore(data["contacts"])
     ctl.zeroing.restore(data["zeroed"])
     ctl.damping.until = [tuple(x) for x in data["damped_until"]]

@@ -23,14 +23,31 @@ def smallest_rayleigh_time():
     return min(times) if times else None
 
 
+#: a step that follows the loading (TimeStep.follow) grows back towards the rules' step by at
+#: most this factor a step: a contact's energy rate changes little over one step of the ~100
+#: of an impact, so a doubled step does not outrun the rate it was chosen for
+STEP_GROWTH = 2.0
+#: ... and falls to no less than this share of the rules' step (a body whose loading asks for
+#: less is read late, and the late-read warning says so)
+STEP_FLOOR = 1e-3
+
+
 class TimeStep:
     """O.dt at most time_step_fraction of the Rayleigh time of the smallest sphere present; a
     smaller O.dt is kept. With time_step_fraction=None the user owns O.dt: warn when it exceeds
-    20 % of that Rayleigh time (Hertz contacts go unstable near it)."""
+    20 % of that Rayleigh time (Hertz contacts go unstable near it).
+
+    On a contact law read every step (contacts/laws.py: reads_every_step) reads cannot come
+    closer, so O.dt also follows the loading (follow): no body's energy rises by more than
+    fast_tolerance of its fracture energy, or half its way to it, in a step, as "fast" reads
+    space theirs (judging.steps_allowed). The rules' step (`ruled`: the scene's, lowered for the
+    finest fragment) comes back as the loading eases."""
 
     def __init__(self, fraction, warn):
         self.fraction = fraction
         self.warn = warn                      # warn(cause, message), once per cause
+        self.ruled = None                     # the rules' O.dt (s), once follow() has run
+        self.chosen = None                    # the O.dt (s) follow() set last
 
     def at_attach(self, rayleigh_time, user_dt):
         """`user_dt`: O.dt if the user set one before attach, else None."""
@@ -59,30 +76,68 @@ class TimeStep:
         self.check(tr)
         return math.inf
 
+    def lower(self, new_dt, moving):
+        """O.dt = new_dt if that is smaller (also the rules' step), the leapfrog kept exact
+        (change)."""
+        if self.ruled is not None:
+            self.ruled = min(self.ruled, new_dt)
+        if new_dt < O.dt:
+            self.change(new_dt, moving)
+
+    def follow(self, limits, moving):
+        """After a read and its breakages: O.dt = the time the loaded bodies allow (`limits`:
+        steps of the present O.dt, judging.steps_allowed; none: no body loading towards its
+        threshold), within STEP_FLOOR to 1 times the rules' step and at most STEP_GROWTH times
+        the present one. An O.dt lowered by someone else meanwhile becomes the rules' step."""
+        dt = O.dt
+        if self.ruled is None or (self.chosen is not None and dt < self.chosen):
+            self.ruled = dt if self.ruled is None else min(self.ruled, dt)
+        want = min(self.ruled, STEP_GROWTH * dt)
+        if limits:
+            want = min(want, dt * min(limits))
+        want = max(want, STEP_FLOOR * self.ruled)
+        if want != dt:
+            self.change(want, moving)
+        self.chosen = O.dt
+
+    def to_list(self):
+        return [self.ruled, self.chosen]
+
+    def restore(self, saved):
+        self.ruled, self.chosen = saved
+
     @staticmethod
-    def lower(new_dt, moving):
+    def change(new_dt, moving):
         """O.dt = new_dt, keeping the leapfrog exact across the change.
 
         YADE's Newton takes v(n+1/2) = v(n-1/2) + a dt with the new dt; across a change the right
         increment is a (dt_old + dt_new) / 2. Without the a (dt_old - dt_new) / 2 added here, a
         body in mid-contact when a breakage shrinks dt gains energy (1.9 % measured on impacts of
-        5.5 mm copper ore at 100 J/kg when dt fell 19-fold). Done for the bodies in
-        tracked contacts (`moving()`, asked only when dt falls), the only ones with a large
-        acceleration that yadebreak knows of."""
+        5.5 mm copper ore at 100 J/kg when dt fell 19-fold). Likewise the spin: the angular
+        momentum where Newton integrates it (aspherical bodies), else the angular velocity. Done
+        for the bodies in tracked contacts (`moving()`, asked only when dt changes), the only
+        ones with a large acceleration that yadebreak knows of."""
         old = O.dt
-        if not new_dt < old:
-            return
         newton = next((e for e in O.engines if isinstance(e, wrapper.NewtonIntegrator)), None)
         gravity = newton.gravity if newton is not None else None
         half = 0.5 * (old - new_dt)
+        exact = newton is not None and newton.exactAsphericalRot
         for bid in moving():
             b = O.bodies[bid]
             if b is None or not b.dynamic:
                 continue
-            accel = O.forces.f(bid) / b.state.mass
+            state = b.state
+            accel = O.forces.f(bid) / state.mass
             if gravity is not None:
                 accel = accel + gravity
-            b.state.vel = b.state.vel + accel * half
+            state.vel = state.vel + accel * half
+            torque = O.forces.t(bid)
+            if b.aspherical and exact:             # Newton integrates the angular momentum
+                state.angMom = state.angMom + torque * half
+            else:
+                inertia = state.inertia
+                state.angVel = state.angVel + type(torque)(
+                    *(torque[k] / inertia[k] * half for k in range(3)))
         O.dt = new_dt
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+from yadebreak.engine.contacts.table import SHARE_A, SHARE_B
+
 
 class Strongest(NamedTuple):
     """A body's most energetic contact at a read."""
@@ -33,6 +35,14 @@ class StrongestContacts:
             return made.other
         found = self._found.get(body)
         return -1 if found is None else found[3]
+
+    def row(self, body):
+        """(row, share column) of a body's strongest contact in the read's table (the column of
+        the body's share, Eq. 4), None if the read did not rank it."""
+        found = self._found.get(body)
+        if found is None:
+            return None
+        return found[1], (SHARE_A if found[2] > 0.0 else SHARE_B)
 
     def get(self, body, default=None):
         made = self._made.get(body)
