@@ -2,7 +2,8 @@
 two runs' outputs compares them without these."""
 
 WALL_KEYS = frozenset({"runtime_s", "wall_s", "wall_time_read_s", "wall_time_replace_s",
-                       "steps_wall_s", "scenes_wall_s", "yade_engines_s"})
+                       "steps_wall_s", "scenes_wall_s", "scene_walls_s", "yade_engines_s",
+                       "wall_time"})
 
 
 def timeless(x):

@@ -89,7 +89,8 @@ class ImpactTally:
     broke (scenes are independently seeded: their scatter is t10's standard error);
     scene_passing: each such scene's progeny mass passing size x RELATIVE_SIEVES (kg), for the
     passing's standard errors;
-    scene_wall_s: the wall time (s) of the scenes added up, wherever each ran; yade_engines_s: of
+    scene_wall_s: the wall time (s) of the scenes added up, wherever each ran; scene_walls: each
+    scene's (s), in scene order (jobs/wall_time predicts from them); yade_engines_s: of
     it, the time YADE's own engines took (timed by YADE; the rest is yadebreak's runners and the
     scenes' building and checks); polyhedra_pair_checks: YADE's silenced do_intersect warnings
     (polyhedra on the volumetric law; 0 otherwise)."""
@@ -109,6 +110,7 @@ class ImpactTally:
     scene_t10: list = field(default_factory=list)
     scene_passing: list = field(default_factory=list)
     scene_wall_s: float = 0.0
+    scene_walls: list = field(default_factory=list)
     yade_engines_s: float = 0.0
     polyhedra_pair_checks: int = 0
 
@@ -155,6 +157,7 @@ class ImpactTally:
         self.e_cum_intact += other.e_cum_intact
         self.scene_t10 += other.scene_t10
         self.scene_passing += other.scene_passing
+        self.scene_walls += other.scene_walls
         self.progeny_mass = self.progeny_mass + other.progeny_mass
         self.marker_mass = self.marker_mass + other.marker_mass
         self.resolved_mass = self.resolved_mass + other.resolved_mass

@@ -21,9 +21,9 @@ from yadebreak import engine, scenes
 from yadebreak.scenes import view
 from yadebreak.analysis import reports
 from yadebreak.criteria import load_material
-from yadebreak.jobs import paraview, skeleton
+from yadebreak.jobs import paraview, skeleton, wall_time
 from yadebreak.jobs.lifecycle import (Heartbeat, Remaining, ScriptError, progress,
-                                       resume_arguments, save_figure, write_atomic)
+                                       resume_arguments, save_figure, status, write_atomic)
 from yadebreak.jobs import options as job_options
 
 
@@ -38,14 +38,21 @@ def single(args):
     mat, target = job_options.material_of(args), job_options.material_of(args, "target")
     out = Path(args.out)
     start = time.time()
+    earlier = _earlier_wall_time(out / "summary.json", _energies(args), args)
+    if earlier is not None:
+        status(f"wall time, predicted: {earlier.line(args.jobs)}")
+
+    told = {}
 
     def write(results, end_reason, end_message):
         """summary.json and, if an energy is done, the plot."""
+        told["wall_time"] = _wall_time(results, "this run's scenes", args)
         summary = {"material": mat.name, "size": args.size, "shape": args.shape,
                    "target": args.target,
                    "share_e": mat.energy_partition(target), "results": results,
                    "runtime_s": time.time() - start, "end_reason": end_reason,
-                   "end_message": end_message}
+                   "end_message": end_message,
+                   "wall_time": told["wall_time"].to_dict()}
         write_atomic(out / "summary.json", json.dumps(summary, indent=2))
         if results:
             reports.plot_breakage(results, mat, args.size, target,
@@ -62,8 +69,32 @@ def single(args):
                                                                  out, start, pool),
             write, limited, validate=lambda energy, result: reports.check_breakage_result(
                 result, mat, args.size, float(energy), target, args.particles))
+    progress(f"wall time: {told['wall_time'].line(args.jobs)}")
     progress(f"wrote {out / 'summary.json'} and {out / 'single_impact.png'}")
     return brk
+
+
+def _wall_time(results, source, args):
+    """The scenes' wall times of `results` (an energy's scenes wait for the energy before) and
+    their prediction on the usual worker counts and on --jobs."""
+    stages = [r.get("scene_walls_s", []) for r in results]
+    return wall_time.predict(stages, source, (*wall_time.WORKERS, args.jobs))
+
+
+def _earlier_wall_time(path, energies, args):
+    """The prediction from an earlier run's summary.json at `path` (--overwrite 1, --resume 1)
+    of the same scenes (energies, particles, scene size), None if there is none."""
+    each = len(scenes.scene_counts(args.particles, args.scene_particles))
+    try:
+        results = json.loads(Path(path).read_text())["results"]
+        same = ([r["specific_energy"] for r in results] == list(energies)
+                and all(r["particles"] == args.particles and len(r["scene_walls_s"]) == each
+                        for r in results))
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if not same:
+        return None
+    return _wall_time(results, f"an earlier run's scene wall times in {path}", args)
 
 
 def _workers(args):
@@ -108,7 +139,8 @@ def _impacts_at(args, mat, target, k, energy, out, start, pool=None):
     result.update({
         "speed": speed, "half_v_squared": energy, "steps": tally.steps, "scenes": tally.scenes,
         "scenes_at_step_limit": tally.scenes_at_step_limit,
-        "scenes_wall_s": tally.scene_wall_s, "yade_engines_s": tally.yade_engines_s,
+        "scenes_wall_s": tally.scene_wall_s, "scene_walls_s": tally.scene_walls,
+        "yade_engines_s": tally.yade_engines_s,
         "mean_specific_energy_measured": (float(np.mean([e["specific_energy"] / share
                                                          for e in intact])) if intact else None),
         "mass_relative_error": tally.mass_relative_error})

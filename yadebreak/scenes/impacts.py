@@ -207,7 +207,9 @@ def run_scenes(spec, which, event_log=None, on_scene=None, watch=None, materials
         tally.steps += ran
         tally.scenes_at_step_limit += int(limited)
         tally.add(brk, ids, initial_mass)
-        tally.scene_wall_s += time.perf_counter() - began
+        wall = time.perf_counter() - began
+        tally.scene_wall_s += wall
+        tally.scene_walls.append(wall)
         tally.yade_engines_s += yade.seconds
         if log is not None:
             append_whole(log, "".join(json.dumps({"scene": k, **e}) + "\n" for e in brk.events))

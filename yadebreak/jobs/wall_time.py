@@ -1,0 +1,61 @@
+"""A command's wall time on N workers, predicted from its scenes' own wall times.
+
+The scenes go to the workers in the command's queue order, each to the first worker free (as the
+pool hands them out), in stages that wait for each other (a single-impact command collects one
+energy's scenes before it queues the next). So a stage takes at least its longest scene (its
+critical path) and at least its scenes' sum over N; `makespan` plays the queue exactly. No YADE.
+"""
+from __future__ import annotations
+
+import heapq
+from dataclasses import dataclass
+
+#: the worker counts a prediction is given for
+WORKERS = (1, 2, 8, 32, 128)
+
+
+def makespan(durations, workers):
+    """Wall time (s) of scenes lasting `durations` (s, in queue order) on `workers` workers that
+    each take the next scene in the queue when free."""
+    free = [0.0] * min(max(int(workers), 1), max(len(durations), 1))
+    for d in durations:
+        heapq.heapreplace(free, free[0] + d)
+    return max(free)
+
+
+@dataclass
+class WallTime:
+    """What the scenes of a command took and would take: scenes (-), sum_s (their wall times
+    added up, s), longest_s (the longest scene, s; no number of workers ends sooner), predicted_s
+    ({workers: s}) and source (where the scenes' times come from)."""
+    scenes: int
+    sum_s: float
+    longest_s: float
+    predicted_s: dict
+    source: str
+
+    def line(self, workers=None):
+        """One line: the sum, the longest scene and the prediction (for `workers` first)."""
+        counts = sorted(set(self.predicted_s) | ({workers} if workers else set()))
+        on = ", ".join(f"{self.predicted_s[n]:.0f} s on {n}" for n in counts
+                       if n in self.predicted_s)
+        return (f"{self.scenes} scenes, {self.sum_s:.0f} s of scenes, the longest "
+                f"{self.longest_s:.0f} s: about {on} worker(s) ({self.source})")
+
+    def to_dict(self):
+        """summary.json's wall_time (docs/outputs.md)."""
+        return {"scenes": self.scenes, "sum_s": self.sum_s, "longest_s": self.longest_s,
+                "predicted": [{"workers": n, "wall_s": s}
+                              for n, s in sorted(self.predicted_s.items())],
+                "source": self.source}
+
+
+def predict(stages, source, workers=WORKERS):
+    """The WallTime of `stages` (lists of scene wall times, s, each in queue order; a stage
+    starts when the one before has ended) on each count of `workers` (and on the workers
+    themselves, if an int is among them)."""
+    every = [d for stage in stages for d in stage]
+    predicted = {int(n): sum(makespan(stage, n) for stage in stages if stage)
+                 for n in workers}
+    return WallTime(len(every), float(sum(every)), float(max(every, default=0.0)), predicted,
+                    source)
