@@ -122,20 +122,22 @@ class TimeStep:
         gravity = newton.gravity if newton is not None else None
         half = 0.5 * (old - new_dt)
         exact = newton is not None and newton.exactAsphericalRot
+        bodies, force_of, torque_of = O.bodies, O.forces.f, O.forces.t
         for bid in moving():
-            b = O.bodies[bid]
+            b = bodies[bid]
             if b is None or not b.dynamic:
                 continue
             state = b.state
-            accel = O.forces.f(bid) / state.mass
+            accel = force_of(bid) / state.mass
             if gravity is not None:
                 accel = accel + gravity
             state.vel = state.vel + accel * half
-            torque = O.forces.t(bid)
-            if b.aspherical and exact:             # Newton integrates the angular momentum
-                state.angMom = state.angMom + torque * half
+            if not b.aspherical:                       # a sphere: isotropic inertia
+                state.angVel = state.angVel + torque_of(bid) * (half / state.inertia[0])
+            elif exact:                                # Newton integrates the angular momentum
+                state.angMom = state.angMom + torque_of(bid) * half
             else:
-                inertia = state.inertia
+                torque, inertia = torque_of(bid), state.inertia
                 state.angVel = state.angVel + type(torque)(
                     *(torque[k] / inertia[k] * half for k in range(3)))
         O.dt = new_dt
