@@ -1,7 +1,8 @@
 """Benchmark: the engine's cost at process scale, beside plain YADE.
 
     /usr/bin/python3 benchmarks/bench_scale.py [--quick] [--sizes 1000,10000,100000] [--repeats 3]
-                                               [--mill-only] [--per-step-only]
+                                               [--mill-only] [--per-step-only] [--events-only]
+                                               [--threads-only]
 
 Two scenes of 5.5 mm copper-ore spheres in a steel box, each built for N bodies:
 - dense: a column on a cubic lattice (each sphere touching its neighbours), under gravity, pressed
@@ -18,7 +19,10 @@ Part 1 also runs a floor: plain YADE with a PyRunner at the default's mean read 
 touches each ore contact's overlap and normal force (as on the mill, part 4, but with the time of
 finding the contacts left out): a lower bound of any reader in Python; what the default costs
 above it is yadebreak's own work. Prints microseconds per step and ratios measured in this run;
---quick runs 1e3 and 1e4 bodies, --per-step-only part 1 alone.
+--quick runs 1e3 and 1e4 bodies, --per-step-only part 1 alone. Part 7 (--threads-only: it alone)
+runs both scenes with the material's own fracture energies (damage events at 3 m/s, breakage out
+of reach) under YADE's OpenMP on 1 and 2 threads, and on 2 threads with OMP_WAIT_POLICY=PASSIVE
+(threads that sleep, not spin, while the engine's Python runs), each in a process of its own.
 """
 import argparse
 import gc
@@ -219,6 +223,51 @@ def event_cost(sizes):
                   f"in contact), {1e3 * first:.1f} ms")
 
 
+#: part 7's settings of YADE's OpenMP, each a child process's environment
+THREADS = {"1 thread": {"OMP_NUM_THREADS": "1"}, "2 threads": {"OMP_NUM_THREADS": "2"},
+           "2 threads, passive": {"OMP_NUM_THREADS": "2", "OMP_WAIT_POLICY": "PASSIVE"}}
+
+
+def threads(sizes, repeats):
+    """Part 7: one child process per THREADS entry (OpenMP reads its settings at start)."""
+    import json
+    import os
+    import subprocess
+    print(f"\n7. The materials' own fracture energies (damage events, no breakage) under YADE's "
+          f"OpenMP threads: us per step, median of {repeats} (plain / default, ratio)")
+    for n in sizes:
+        for name, env in THREADS.items():
+            child = subprocess.run(
+                [sys.executable, __file__, "--threads-child", "--sizes", str(n), "--repeats",
+                 str(repeats)], env={**os.environ, **env}, capture_output=True, text=True,
+                check=True)
+            got = json.loads(child.stdout.strip().splitlines()[-1])
+            print(f"  {n:7d} bodies, {name:18s}: " + "; ".join(
+                f"{kind} {r['plain']:8.1f} / {r['default']:8.1f} ({r['default'] / r['plain']:.2f}x, "
+                f"+{r['default'] - r['plain']:.0f} us, {r['damage']} damage events)"
+                for kind, r in got.items()))
+
+
+def _threads_child(n, repeats):
+    """Part 7 in this process: each scene in plain YADE and with the default, in turn; one JSON
+    line {kind: {plain, default: us per step, damage: events in the last default run}}."""
+    import json
+    out = {}
+    for kind in ("dense", "collisional"):
+        runs = {"plain": [], "default": []}
+        for _ in range(repeats):
+            for mode in runs:
+                brk, _ = prepare(kind, n, mode, breakable=True)
+                gc.collect()
+                t0 = time.perf_counter()
+                engine.run_steps(steps_for(n))
+                runs[mode].append(1e6 * (time.perf_counter() - t0) / steps_for(n))
+                damage = 0 if brk is None else sum(e["kind"] == "damage" for e in brk.events)
+        out[kind] = {mode: float(np.median(v)) for mode, v in runs.items()}
+        out[kind]["damage"] = damage
+    print(json.dumps(out))
+
+
 def _mill_args(out):
     """The default mill of scripts/ball_mill.py."""
     from argparse import Namespace
@@ -334,13 +383,21 @@ def main():
                         help="only the cost per step with breakage out of reach (part 1)")
     parser.add_argument("--events-only", action="store_true",
                         help="only the cost of a breakage event (part 3)")
+    parser.add_argument("--threads-only", action="store_true",
+                        help="only the materials' own fracture energies on 1 and 2 threads "
+                             "(part 7)")
+    parser.add_argument("--threads-child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(sys.argv[1:])
     if args.mill_only:
         return mill(repeats=args.repeats)
     sizes = ([int(float(s)) for s in args.sizes.split(",")] if args.sizes
              else [1000, 10000] if args.quick else [1000, 10000, 100000])
+    if args.threads_child:
+        return _threads_child(sizes[0], args.repeats)
     if args.events_only:
         return event_cost(sizes)
+    if args.threads_only:
+        return threads(sizes, args.repeats)
     attach_times = per_step(sizes, args.repeats)
     if args.per_step_only:
         return None
@@ -350,6 +407,7 @@ def main():
     print("\n5. attach() on the dense scene: " + ", ".join(
         f"{n} bodies {t:.2f} s" for n, t in attach_times.items()))
     memory(max(sizes))
+    threads([min(sizes)], args.repeats)
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"peak memory of this process {peak:.0f} MB")
 
