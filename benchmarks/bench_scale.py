@@ -26,7 +26,10 @@ of reach) under YADE's OpenMP on 1 and 2 threads, and on 2 threads with OMP_WAIT
 """
 import argparse
 import gc
+import json
+import os
 import resource
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -230,9 +233,6 @@ THREADS = {"1 thread": {"OMP_NUM_THREADS": "1"}, "2 threads": {"OMP_NUM_THREADS"
 
 def threads(sizes, repeats):
     """Part 7: one child process per THREADS entry (OpenMP reads its settings at start)."""
-    import json
-    import os
-    import subprocess
     print(f"\n7. The materials' own fracture energies (damage events, no breakage) under YADE's "
           f"OpenMP threads: us per step, median of {repeats} (plain / default, ratio)")
     for n in sizes:
@@ -251,20 +251,14 @@ def threads(sizes, repeats):
 def _threads_child(n, repeats):
     """Part 7 in this process: each scene in plain YADE and with the default, in turn; one JSON
     line {kind: {plain, default: us per step, damage: events in the last default run}}."""
-    import json
     out = {}
     for kind in ("dense", "collisional"):
         runs = {"plain": [], "default": []}
         for _ in range(repeats):
-            for mode in runs:
-                brk, _ = prepare(kind, n, mode, breakable=True)
-                gc.collect()
-                t0 = time.perf_counter()
-                engine.run_steps(steps_for(n))
-                runs[mode].append(1e6 * (time.perf_counter() - t0) / steps_for(n))
-                damage = 0 if brk is None else sum(e["kind"] == "damage" for e in brk.events)
+            for mode in runs:                     # the default last: its controller stays
+                runs[mode].append(rate(kind, n, mode, steps_for(n), breakable=True)[0])
         out[kind] = {mode: float(np.median(v)) for mode, v in runs.items()}
-        out[kind]["damage"] = damage
+        out[kind]["damage"] = sum(e["kind"] == "damage" for e in engine.controller_of().events)
     print(json.dumps(out))
 
 

@@ -40,7 +40,7 @@ def single(args):
     start = time.time()
     earlier = _earlier_wall_time(out / "summary.json", _energies(args), args)
     if earlier is not None:
-        status(f"wall time, predicted: {earlier.line(args.jobs)}")
+        status(f"wall time, predicted: {earlier.line()}")
 
     told = {}
 
@@ -69,7 +69,7 @@ def single(args):
                                                                  out, start, pool),
             write, limited, validate=lambda energy, result: reports.check_breakage_result(
                 result, mat, args.size, float(energy), target, args.particles))
-    progress(f"wall time: {told['wall_time'].line(args.jobs)}")
+    progress(f"wall time: {told['wall_time'].line()}")
     progress(f"wrote {out / 'summary.json'} and {out / 'single_impact.png'}")
     return brk
 

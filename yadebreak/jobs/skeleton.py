@@ -27,9 +27,8 @@ skips them.
 """
 import math
 import time
-from pathlib import Path
-
 from contextlib import nullcontext
+from pathlib import Path
 
 from yadebreak.jobs.lifecycle import (CHECKPOINT, Heartbeat, PartialResults, Remaining,
                                        check_not_finished, check_resume_arguments, mark_finished,

@@ -34,11 +34,9 @@ class WallTime:
     predicted_s: dict
     source: str
 
-    def line(self, workers=None):
-        """One line: the sum, the longest scene and the prediction (for `workers` first)."""
-        counts = sorted(set(self.predicted_s) | ({workers} if workers else set()))
-        on = ", ".join(f"{self.predicted_s[n]:.0f} s on {n}" for n in counts
-                       if n in self.predicted_s)
+    def line(self):
+        """One line: the sum, the longest scene and the prediction on each count of workers."""
+        on = ", ".join(f"{s:.0f} s on {n}" for n, s in sorted(self.predicted_s.items()))
         return (f"{self.scenes} scenes, {self.sum_s:.0f} s of scenes, the longest "
                 f"{self.longest_s:.0f} s: about {on} worker(s) ({self.source})")
 
@@ -52,8 +50,7 @@ class WallTime:
 
 def predict(stages, source, workers=WORKERS):
     """The WallTime of `stages` (lists of scene wall times, s, each in queue order; a stage
-    starts when the one before has ended) on each count of `workers` (and on the workers
-    themselves, if an int is among them)."""
+    starts when the one before has ended) on each count in `workers`."""
     every = [d for stage in stages for d in stage]
     predicted = {int(n): sum(makespan(stage, n) for stage in stages if stage)
                  for n in workers}
