@@ -254,26 +254,3 @@ def test_breakage_probability_does_not_depend_on_the_scene_size(scene):
     assert all(abs(f - p_model) < 3 * sigma for f in fractions), (fractions, p_model)
 
 
-@pytest.mark.yade
-def test_scenes_shared_among_processes_give_the_same_run(scene, tmp_path):
-    """Five scenes of one copper ore particle at 700 J/kg, run here and by two YADE processes
-    taking scenes from a queue: the same events in the same order (each scene has its seed), and
-    the same result to the last digit (the scenes' tallies are merged in scene order). Either way
-    the tally carries the time YADE's own engines took, a part of the scenes' time, and YADE's
-    timing is left as it was."""
-    from yadebreak.analysis import reports
-    from yadebreak import scenes
-    cu, steel, speed = load_material("copper_ore"), load_material("steel"), np.sqrt(2 * 700.0)
-    results, logs = [], []
-    for jobs in (1, 2):
-        log = tmp_path / f"events_{jobs}.jsonl"
-        tally, _ = scenes.single_impacts("copper_ore", 5.5e-3, speed, 5, 1, 4,
-                                         event_log=str(log), jobs=jobs)
-        results.append((reports.breakage_result_of(tally, cu, 700.0, steel), tally.steps,
-                        tally.scenes, tally.mass_relative_error < 1e-12))
-        logs.append(log.read_text())
-        assert 0.0 < tally.yade_engines_s < tally.scene_wall_s
-        assert not scene.timingEnabled
-    assert logs[0] == logs[1] and '"kind": "breakage"' in logs[0]
-    assert json.dumps(results[0]) == json.dumps(results[1]) and results[0][2] == 5
-    assert not (tmp_path / "events_2.workers").exists()          # the workers' files joined

@@ -1,5 +1,6 @@
 """The `yade` launcher starts a Python prompt and an XMLRPC server that listen on every
-interface; every script and pool worker closes both as it starts (YADE)."""
+interface; every script closes both as it starts, and a local Dask cluster listens on the
+loopback only (YADE)."""
 import os
 import signal
 import subprocess
@@ -81,33 +82,40 @@ def test_a_script_closes_the_launchers_servers_as_it_starts(tmp_path):
         _stop(proc)
 
 
-def test_a_pool_worker_closes_them_too(tmp_path):
-    """A worker of the impact pool, started as the pool starts it, given one task whose spec is
-    a named pipe: it waits there, inside its loop, while its ports are read."""
-    import json
-    for name in ("queue", "claimed", "set"):
-        (tmp_path / name).mkdir()
-    os.mkfifo(tmp_path / "set" / "spec.json")
-    (tmp_path / "queue" / "0").write_text(json.dumps({"set": str(tmp_path / "set"), "scene": 0}))
-    proc = subprocess.Popen(["yade", "-n", "-x",
-                             str(ROOT / "yadebreak" / "jobs" / "impact_worker.py"),
-                             str(tmp_path), "0", str(ROOT)], cwd=tmp_path,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+def listening_addresses(pid):
+    """The IPv4 addresses process `pid` listens on (dotted), from /proc/net/tcp."""
+    inodes = {os.readlink(fd)[8:-1] for fd in Path(f"/proc/{pid}/fd").iterdir()
+              if os.readlink(fd).startswith("socket:[")}
+    found = set()
+    for line in Path("/proc/net/tcp").read_text().splitlines()[1:]:
+        fields = line.split()
+        if fields[3] == "0A" and fields[9] in inodes:
+            raw = bytes.fromhex(fields[1].split(":")[0])[::-1]     # little-endian
+            found.add(".".join(str(b) for b in raw))
+    return found
+
+
+def test_a_local_cluster_listens_on_the_loopback_only():
+    """The scheduler, its dashboard and its workers (scenes on --jobs 2): nothing another
+    machine can reach; the cluster and its workers end with close()."""
+    from yadebreak.process.scheduler import LocalCluster
+    cluster = LocalCluster(1)
     try:
-        deadline = time.time() + 120
-        while not (tmp_path / "claimed" / "0.0").exists() and time.time() < deadline:
-            time.sleep(0.1)
-        assert (tmp_path / "claimed" / "0.0").exists()
-        assert listening_ports(proc.pid) == []
+        family = [cluster._proc.pid]
+        for stat in Path("/proc").glob("[0-9]*/stat"):
+            try:
+                if int(stat.read_text().rsplit(")", 1)[1].split()[1]) == cluster._proc.pid:
+                    family.append(int(stat.parent.name))
+            except (OSError, IndexError):
+                continue
+        addresses = set().union(*(listening_addresses(pid) for pid in family))
+        assert addresses and addresses <= {"127.0.0.1"}, addresses
     finally:
-        (tmp_path / "stop").touch()
-        try:                                 # lets it go (and fail) if it waits there
-            pipe = os.open(tmp_path / "set" / "spec.json", os.O_WRONLY | os.O_NONBLOCK)
-            os.write(pipe, b"{}")
-            os.close(pipe)
-        except OSError:                      # no reader: it never got there
-            proc.kill()
-        proc.wait(60)
+        cluster.close()
+    assert cluster._proc.poll() is not None
+    assert not any(Path(f"/proc/{pid}").exists() for pid in family[1:]
+                   if Path(f"/proc/{pid}/stat").exists()
+                   and Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z")
 
 
 def test_attach_closes_them_in_a_users_own_scene_and_says_so_once(tmp_path):

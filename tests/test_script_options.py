@@ -104,12 +104,11 @@ def test_speeds_below_the_wave_speed_are_accepted():
     assert _read("single_impact", "--energies", "8.8e6", "--out", "x") is None
 
 
-def test_jobs_default_to_the_usable_cores():
-    from yadebreak.studies.verify import PARAMS
+def test_scenes_go_to_a_worker_per_usable_core_by_default():
+    from yadebreak.options.flags import scheduler_of
     cores = len(os.sched_getaffinity(0))
-    assert job_options.read("single_impact", None, []).jobs == cores
-    assert [p.default for p in PARAMS if p.name == "jobs"] == [cores]
-    assert job_options.read("single_impact", None, ["--jobs", "1"]).jobs == 1
+    assert scheduler_of(job_options.read("single_impact", None, [])).count == cores
+    assert scheduler_of(job_options.read("single_impact", None, ["--jobs", "1"])).in_process
 
 
 def test_a_tables_unknown_column_is_named_in_one_line(monkeypatch, capsys):

@@ -94,9 +94,9 @@ def test_flatten_gives_dotted_names():
 
 
 def test_bad_scheduler_is_refused_in_one_line():
-    pytest.importorskip("distributed")
+    from yadebreak.process.scheduler import SchedulerError
     for spec in ("local:x", "local:0", "cluster"):
-        with pytest.raises(sweep.SweepError, match="--scheduler"):
+        with pytest.raises(SchedulerError, match="--scheduler"):
             sweep.connect(spec)
 
 

@@ -115,12 +115,12 @@ def test_a_run_waits_for_the_fragments_still_flying_towards_the_plate(scene):
     assert not later & {"breakage", "unbreakable_stressed"}, brk.events[events:]
 
 
-def test_runs_queued_together_in_a_pool_give_what_they_give_one_by_one(scene):
+def test_runs_queued_together_on_workers_give_what_they_give_one_by_one(scene):
     """Three sets of 5.5 mm copper ore impacts (one replacing at two energies, one for the
     probability only, and drop-weight tests, each particle its own scene), queued together to
-    two worker processes, the costliest first: every result is the one the runs give one after
-    the other in this process, to the last digit (but the time taken); each set ran once, and
-    the pool is gone after close()."""
+    two workers, the costliest first: every result is the one the runs give one after the other
+    in this process, to the last digit (but the time taken); each set ran once, and the queue
+    is gone after close()."""
     from yadebreak.studies.verify.settings import Run, Runner, paper_options
     runs = [Run("copper_ore", 5.5e-3, [700.0, 1500.0], 3, (4, 5),
                 paper_options(0.05, read_period="fast")),
@@ -128,16 +128,17 @@ def test_runs_queued_together_in_a_pool_give_what_they_give_one_by_one(scene):
                 per_scene=3),
             Run("copper_ore", 5.5e-3, [1500.0], 2, (4,), paper_options(0.05, read_period="fast"),
                 test="drop_weight")]
+    from yadebreak.process.scheduler import Scheduler
     results = []
-    for jobs in (1, 2):
-        runner = Runner(jobs)
+    for workers in (1, 2):
+        runner = Runner(Scheduler("local", workers))
         try:
             results.append(runner.run_all(runs))
-            pool = runner._pool
             assert len(runner.results) == 4
+            assert sorted(runner.walls) == sorted(runner.order)     # every set once, timed
         finally:
             runner.close()
-        assert pool is None or not pool.folder
+        assert runner._queue is None
     assert json.dumps(timeless(results[0])) == json.dumps(timeless(results[1]))
     assert results[1][0][1]["breakage_events_all_generations"] > 0
     drop_weight = results[1][2][0]
@@ -150,9 +151,8 @@ def test_the_plan_holds_every_figure_s_first_runs_and_leaves_no_plot_open(tmp_pa
     """plan() (the runs queued at the start of the command) asks each figure for its runs
     without running anything: quick Figs. 13-19 come to five fragmentation runs at 1000 J/kg
     (2 % RT with the file's damping, 5 % RT, damping 0, cs 1; the drop weight), Figs. 8-10 to
-    their probability
-    runs, the energy audit to one task; Fig. 11 runs in this process and is not in it; no figure
-    is left open."""
+    their probability runs, Fig. 11 to a task per gamma (quick: 5 and 10, 40 particles at 94.7
+    J/kg), the energy audit to one task; no figure is left open."""
     from yadebreak.studies.verify.report import plt_module
     from yadebreak.studies.verify.settings import Task, plan
     from yadebreak.options.flags import ScriptParser, add_params, read_params
@@ -164,12 +164,14 @@ def test_the_plan_holds_every_figure_s_first_runs_and_leaves_no_plot_open(tmp_pa
     planned = plan(list(verify.FIGURES[name] for name in verify.DEFAULT_FIGURES), args, tmp_path)
     tasks = [t for t in planned if isinstance(t, Task)]
     runs = [r for r in planned if not isinstance(r, Task)]
-    # the energy audit's one particle (quick: copper ore at 1000 J/kg), queued with the rest
-    assert [(t.spec["material"], t.spec["energy"], t.spec["counts"]) for t in tasks] == [
-        ("copper_ore", 1000.0, [1])]
+    # Fig. 11's scene per gamma, the energy audit's one particle (quick: copper ore at 1000
+    # J/kg), queued with the rest
+    assert [(t.spec.get("gamma"), t.spec["energy"], t.spec["counts"]) for t in tasks] == [
+        (5.0, 94.7, [40]), (10.0, 94.7, [40]), (None, 1000.0, [1])]
+    assert tasks[2].spec["material"] == "copper_ore"
     keys = {run.key(e) for run in runs for e in run.energies}
     fragmentation = {k for k in keys if '0.029' in k}
     assert len(fragmentation) == 5 and sum('"drop_weight"' in k for k in fragmentation) == 1
     assert all('"replace", false' in k for k in keys - fragmentation)
-    assert {run.size for run in runs} == {2.8e-3, 5.5e-3, 11e-3, 29e-3}      # no 37.5 mm (Fig. 11)
+    assert {run.size for run in runs} == {2.8e-3, 5.5e-3, 11e-3, 29e-3}      # Fig. 11: tasks
     assert plt_module().get_fignums() == []

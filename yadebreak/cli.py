@@ -16,6 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from yadebreak.process.scheduler import FORMS
 from yadebreak.model import families
 from yadebreak.jobs.lifecycle import LOCK, save_figure, status, tool_run, write_atomic
 from yadebreak import model
@@ -122,7 +123,7 @@ def sweep(args):
         lines = sw.run_sweep(args.table, args.script, args.out, scheduler=args.scheduler,
                              retries=args.retries, jobqueue_options=options, jobs=args.jobs,
                              say=lambda m: print(f"[yadebreak] {m}", flush=True), tell=status)
-    except sw.SweepError as exc:
+    except sw.SchedulerError as exc:          # a SweepError too
         fail(str(exc))
     except KeyboardInterrupt:
         raise SystemExit(130) from None
@@ -155,7 +156,7 @@ follow SCRIPT and reach every run."""
 def tradeoff_command(argv):
     """`yadebreak tradeoff`: its own parser, as the script's options pass through."""
     from yadebreak.studies import tradeoff as to
-    from yadebreak.studies.sweep import SweepError
+    from yadebreak.process.scheduler import SchedulerError
     parser = ScriptParser(prog="yadebreak tradeoff", usage=TRADEOFF_USAGE,
                           allow_abbrev=False)
     parser.add_argument("script", help="the YADE script (takes --seed, --out and the options)")
@@ -183,7 +184,7 @@ def tradeoff_command(argv):
                reference_text=args.reference, scheduler=args.scheduler,
                retries=numbers["retries"], say=lambda m: print(f"[yadebreak] {m}", flush=True),
                tell=status)
-    except (to.TradeoffError, SweepError) as exc:
+    except (to.TradeoffError, SchedulerError) as exc:
         fail(str(exc))
     except KeyboardInterrupt:
         raise SystemExit(130) from None
@@ -237,10 +238,9 @@ COMMANDS = {
     "sweep": Command(sweep, "run a yade-batch table's lines as Dask tasks, on this machine or a cluster", [
         out_option("out/sweep", "folder of the sweep: <out>/<description>/ per line, "
                    "sweep.json, sweep.csv"),
-        text("scheduler", "local", "local, local:N (N workers), tcp://HOST:PORT (a running "
-             "scheduler), slurm or pbs (dask-jobqueue)"),
+        text("scheduler", "local", FORMS),
         integer("retries", 1, "further attempts of a failing line in this call", lo=0),
-        integer("jobs", 1, "slurm/pbs: batch jobs to start (each one worker)", lo=1),
+        integer("jobs", 1, "slurm/pbs without :N: batch jobs to start (each one worker)", lo=1),
         text("jobqueue", "", "slurm/pbs: the cluster's options as key=value,... (e.g. "
              "queue=short,walltime=02:00:00,memory=4GB,cores=1)")],
         (("table", "the yade-batch table"), ("script", "the YADE script each line runs"))),

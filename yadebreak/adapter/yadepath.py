@@ -23,6 +23,16 @@ def one_openmp_thread():
         pass
 
 
+def builtins_in_main():
+    """YADE sets an engine's label by running `__builtins__.<label> = ...` in __main__; where
+    __main__ holds the builtins as a dict (a Dask worker's process), that fails: give it the
+    module, as a script's __main__ has."""
+    import builtins
+    main = sys.modules.get("__main__")
+    if main is not None and getattr(main, "__builtins__", builtins) is not builtins:
+        main.__builtins__ = builtins
+
+
 def ensure_yade_importable():
     """Return True if yade can be imported, adding Debian's yade-double/py to sys.path if needed.
 
@@ -35,6 +45,7 @@ def ensure_yade_importable():
     """
     if os.environ.get("OMP_NUM_THREADS") == "1":
         one_openmp_thread()
+    builtins_in_main()
     if importlib.util.find_spec("yade") is not None:
         try:
             spec = importlib.util.find_spec("yade.wrapper")

@@ -63,10 +63,10 @@ def single(args):
         at = [r["specific_energy"] for r in results if r["scenes_at_step_limit"]]
         return f"scenes stopped at the step limit at {at} J/kg" if at else ""
 
-    with _workers(args) as pool:
+    with _queue(args) as queue:
         brk = skeleton.run_units(
             args, _energies(args), lambda k, energy: _impacts_at(args, mat, target, k, energy,
-                                                                 out, start, pool),
+                                                                 out, start, queue),
             write, limited, validate=lambda energy, result: reports.check_breakage_result(
                 result, mat, args.size, float(energy), target, args.particles))
     progress(f"wall time: {told['wall_time'].line()}")
@@ -78,7 +78,8 @@ def _wall_time(results, source, args):
     """The scenes' wall times of `results` (an energy's scenes wait for the energy before) and
     their prediction on the usual worker counts and on --jobs."""
     stages = [r.get("scene_walls_s", []) for r in results]
-    return wall_time.predict(stages, source, (*wall_time.WORKERS, args.jobs))
+    count = job_options.scheduler_of(args).count
+    return wall_time.predict(stages, source, (*wall_time.WORKERS, *([count] if count else [])))
 
 
 def _earlier_wall_time(path, energies, args):
@@ -97,21 +98,25 @@ def _earlier_wall_time(path, energies, args):
     return _wall_time(results, f"an earlier run's scene wall times in {path}", args)
 
 
-def _workers(args):
-    """The worker processes of every energy (scenes.workers_for), started once for the run,
-    where a pool per energy would start YADE again each time; a null context without any."""
-    workers = scenes.workers_for(args.jobs, scenes.scene_counts(args.particles,
-                                                                args.scene_particles))
-    return scenes.ImpactPool(workers) if workers else contextlib.nullcontext()
+def _queue(args):
+    """The queue of every energy's scenes on --scheduler (scenes.on_workers), connected once
+    for the run, where one per energy would start the workers again each time; a null context
+    where this process runs them."""
+    scheduler = job_options.scheduler_of(args)
+    if not scenes.on_workers(scheduler, scenes.scene_counts(args.particles,
+                                                           args.scene_particles)):
+        return contextlib.nullcontext()
+    progress(f"scenes on {scheduler}")
+    return scenes.SceneQueue(scheduler, args.retries)
 
 
-def _impacts_at(args, mat, target, k, energy, out, start, pool=None):
-    """The particles fired at `energy` (J/kg) in scenes of --scene-particles, by the workers
-    `pool` if any: (the last scene's controller, the energy's result)."""
+def _impacts_at(args, mat, target, k, energy, out, start, queue=None):
+    """The particles fired at `energy` (J/kg) in scenes of --scene-particles, by the workers of
+    `queue` if any: (the last scene's controller, the energy's result)."""
     speed = float(np.sqrt(2 * energy))
     counts = scenes.scene_counts(args.particles, args.scene_particles)
     seen = {"done": 0, "tally": None}
-    in_process = pool is None          # _workers made a pool wherever there are workers
+    in_process = queue is None         # _queue made one wherever there are workers
     remaining = Remaining()
 
     def on_scene(done, scenes_total, tally):
@@ -131,7 +136,7 @@ def _impacts_at(args, mat, target, k, energy, out, start, pool=None):
         tally, brk = scenes.single_impacts(
             mat, args.size, speed, args.particles, args.scene_particles, args.seed + k,
             target=target, event_log=str(out / f"events_{energy:g}.jsonl"), on_scene=on_scene,
-            jobs=args.jobs, pool=pool, shape=args.shape, watch=_frames(args, out, energy),
+            queue=queue, shape=args.shape, watch=_frames(args, out, energy),
             **job_options.attach_options("single_impact", args))
     share = mat.energy_partition(target)
     result = reports.breakage_result_of(tally, mat, energy, target)

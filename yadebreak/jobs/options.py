@@ -22,8 +22,9 @@ from yadebreak.options.engine_flags import (OPTION, Derived, Override, engine_fl
 from yadebreak.options.engine_flags import options_from_flags
 from yadebreak.options.table import options_markdown
 from yadebreak.options.flags import (checkpointed_run_options, choice, fail, flag, integer,
-                                     jobs_option, material_option, number, numbers, out_option,
-                                     overwrite_option, script_params, size_option, text)
+                                     material_option, number, numbers, out_option,
+                                     overwrite_option, scheduler_of, scheduler_options,
+                                     script_params, size_option, text)
 
 
 @dataclass(frozen=True)
@@ -291,7 +292,7 @@ SINGLE_IMPACT = laboratory_test(5.5e-3, [
     integer("scene_particles", 1, "particles per scene: independent scenes of at most this "
             "many, each at the time step of its own finest fragment and ending with its own "
             "cascade", lo=1),
-    jobs_option("YADE processes sharing the scenes (the results do not depend on it)"),
+    *scheduler_options("scenes"),
     _seed_per_energy(),
     _target_option(),
     numbers("energies", "100,200,400", "J/kg", "specific impact energies Ek/mp = v^2/2",
@@ -302,7 +303,7 @@ SINGLE_IMPACT = laboratory_test(5.5e-3, [
     number("vtk_interval", 0.0, "s", "simulated time between ParaView frames of the first "
            "scene of each energy, in <out>/paraview_<energy> (0: none; with --jobs 1)", lo=0),
 ], "out/single_impact", _KEEPING_ENERGIES, "energies", engine=("replace",),
-    check=lambda args: _check_specific_energies(args, "energies"),
+    check=lambda args: (_check_specific_energies(args, "energies"), scheduler_of(args)),
     materials=("material", "target"))
 
 REPEATED_IMPACT = laboratory_test(37.5e-3, [

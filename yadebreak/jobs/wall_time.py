@@ -1,14 +1,17 @@
 """A command's wall time on N workers, predicted from its scenes' own wall times.
 
-The scenes go to the workers in the command's queue order, each to the first worker free (as the
-pool hands them out), in stages that wait for each other (a single-impact command collects one
-energy's scenes before it queues the next). So a stage takes at least its longest scene (its
-critical path) and at least its scenes' sum over N; `makespan` plays the queue exactly. No YADE.
+The scenes go to the workers in the command's queue order, in tasks of consecutive scenes
+(process.scheduler.chunk_size), each task to the first worker free, in stages that wait for each
+other (a single-impact command collects one energy's scenes before it queues the next). So a stage
+takes at least its longest task (its critical path) and at least its scenes' sum over N;
+`makespan` plays the queue exactly. No YADE.
 """
 from __future__ import annotations
 
 import heapq
 from dataclasses import dataclass
+
+from yadebreak.process.scheduler import chunk_size
 
 #: the worker counts a prediction is given for
 WORKERS = (1, 2, 8, 32, 128)
@@ -48,11 +51,20 @@ class WallTime:
                 "source": self.source}
 
 
+def tasks(durations, workers):
+    """The wall times (s) of the tasks that scenes lasting `durations` go out in on `workers`
+    workers (one on one worker: this process runs them, none go out)."""
+    size = chunk_size(len(durations), workers) if workers > 1 else 1
+    return [sum(durations[i:i + size]) for i in range(0, len(durations), size)]
+
+
 def predict(stages, source, workers=WORKERS):
-    """The WallTime of `stages` (lists of scene wall times, s, each in queue order; a stage
-    starts when the one before has ended) on each count in `workers`."""
-    every = [d for stage in stages for d in stage]
-    predicted = {int(n): sum(makespan(stage, n) for stage in stages if stage)
-                 for n in workers}
+    """The WallTime of `stages` (a stage starts when the one before has ended: a list of scene
+    wall times (s) in queue order, one set of scenes; or a list of such sets, queued together, as
+    verify queues every figure's runs) on each count in `workers`."""
+    stages = [stage if stage and isinstance(stage[0], list) else [stage] for stage in stages]
+    every = [d for stage in stages for one in stage for d in one]
+    predicted = {int(n): sum(makespan([t for one in stage for t in tasks(one, n)], n)
+                             for stage in stages) for n in workers}
     return WallTime(len(every), float(sum(every)), float(max(every, default=0.0)), predicted,
                     source)

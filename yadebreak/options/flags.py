@@ -32,6 +32,7 @@ from dataclasses import dataclass
 from decimal import Decimal
 
 from yadebreak.model.intervals import PARTICLE_SIZE, Interval
+from yadebreak.process.scheduler import FORMS, SchedulerError, chosen, usable_cores
 
 #: unit of an option -> the units accepted after a number, with their factor to that unit
 UNITS = {
@@ -122,7 +123,10 @@ class Param:
         default = int(bool(self.default)) if self.kind == "flag" else self.default
         unit = f" {self.unit}" if self.numeric and self.unit != "-" else ""
         unit = "" if default in self.words else unit
-        parts.append(f"default {default}{unit}" + (f" ({self.why})" if self.why else ""))
+        if default is None and self.why:
+            parts.append(f"default: {self.why}")
+        else:
+            parts.append(f"default {default}{unit}" + (f" ({self.why})" if self.why else ""))
         return "; ".join(parts).replace("%", "%%")       # argparse %-formats help strings
 
     def _error(self, value, why=""):
@@ -285,19 +289,25 @@ def out_option(default, help="output folder"):
     return text("out", default, help, empty=False)
 
 
-def usable_cores():
-    """The cores this process may use (its CPU affinity): the default of every --jobs that
-    counts processes on this machine."""
+def scheduler_options(what):
+    """--jobs and --scheduler (process/scheduler.py) of a command whose `what` are Dask tasks:
+    --jobs N is --scheduler local:N; neither given: a worker per core."""
+    return [Param("jobs", None, "integer", "processes", f"processes on this machine running "
+                  f"the {what} (--scheduler local:N)", lo=1,
+                  why="the cores this process may use, unless --scheduler is given"),
+            text("scheduler", "", f"where the {what} run: {FORMS} (default: local, a worker "
+                 "per core); the results do not depend on it"),
+            integer("retries", 1, f"further attempts of a {what[:-1]} whose worker failed",
+                    lo=0)]
+
+
+def scheduler_of(args):
+    """The process.scheduler.Scheduler of a command's --scheduler and --jobs; both given, or a
+    form not accepted, ends the program with its one line (fail)."""
     try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:                         # no affinity on this system
-        return os.cpu_count() or 1
-
-
-def jobs_option(help):
-    """--jobs: processes on this machine sharing the work; the results do not depend on it."""
-    return integer("jobs", usable_cores(), help + " (default: the cores this process may use)",
-                   lo=1, unit="processes")
+        return chosen(args.scheduler, args.jobs)
+    except SchedulerError as exc:
+        fail(str(exc))
 
 
 DEBUG = flag("debug", False, "show the traceback of an error instead of its one line")

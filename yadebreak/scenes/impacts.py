@@ -77,8 +77,8 @@ def scene_seed(seed, scene):
 
 
 def single_impacts(material, size, speed, particles, per_scene, seed, target="steel",
-                   event_log=None, on_scene=None, max_steps=200000, jobs=1,
-                   wait_for_arrivals=False, pool=None, shape="sphere", watch=None,
+                   event_log=None, on_scene=None, max_steps=200000, scheduler=None,
+                   wait_for_arrivals=False, queue=None, shape="sphere", watch=None,
                    **options):
     """`particles` particles fired at `speed` (m/s) normally at a plate, `per_scene` at a time in
     independent scenes, each run to its own end (run_until_rebound with its controller).
@@ -87,14 +87,15 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     step of the finest fragment of any (200 ab_t10_ore particles of 12 mm at 160 J/kg: 470 s in
     one scene; docs/high_energy.md). The particles are independent either way: nothing touches
     across the 4-diameter spacing during an impact. Scene k is seeded scene_seed(seed, k), so
-    the result does not depend on `jobs`: with jobs > 1 (or an impact_pool.ImpactPool `pool`,
-    which a job keeps for all its runs) the scenes are run by YADE worker processes, each taking
-    the next scene when it is free, and their tallies are merged in scene order.
+    the result does not depend on where they run: on a `scheduler` (process.scheduler; None or
+    local:1: this process), or a queue.SceneQueue `queue` that a job keeps for all its runs, the
+    scenes are Dask tasks, each worker taking the next scene when it is free, and their tallies
+    are merged in scene order.
 
     Events go to `event_log` (each with its `scene`), the running scene's to `<log>.scene.jsonl`
-    until it ends (with workers: each scene's to `<log>.workers/<scene>.jsonl`, joined at the
-    end; a failed run leaves them there). on_scene(scenes done, scenes, tally) after each scene
-    (progress lines). A scene stops after max_steps at the latest (counted in
+    until it ends (on workers: each scene's to `<log>.workers/<scene>.jsonl` as it arrives,
+    joined at the end; a failed run leaves them there). on_scene(scenes done, scenes, tally)
+    after each scene (progress lines). A scene stops after max_steps at the latest (counted in
     tally.scenes_at_step_limit). `material`, `target`: Materials, or names or paths (workers get
     them as text, the file a Material was read from). Returns
     (reports.ImpactTally, with the steps of every scene; the last scene's controller, None with
@@ -105,13 +106,12 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     with workers it is not called)."""
     spec = impact_spec(_named(material), size, speed, particles, per_scene, seed, _named(target),
                        max_steps, wait_for_arrivals, shape, **options)
-    if pool is not None:
-        return pool.collect(pool.submit(spec, event_log), on_scene), None
-    workers = workers_for(jobs, spec["counts"])
-    if workers:
-        from yadebreak.scenes.impact_pool import ImpactPool
-        with ImpactPool(workers) as own:
+    if queue is None and on_workers(scheduler, spec["counts"]):
+        from yadebreak.scenes.queue import SceneQueue
+        with SceneQueue(scheduler) as own:
             return own.collect(own.submit(spec, event_log), on_scene), None
+    if queue is not None:
+        return queue.collect(queue.submit(spec, event_log), on_scene), None
     if event_log is not None:
         Path(event_log).write_text("")
     return run_scenes(spec, range(len(spec["counts"])), event_log, on_scene, watch,
@@ -146,7 +146,7 @@ def impact_spec(material, size, speed, particles, per_scene, seed, target="steel
 
 def drop_weight_spec(material, size, specific_energy, particles, per_scene, seed, max_time,
                      **options):
-    """Drop-weight tests as plain JSON, run like single impacts (run_scenes, an ImpactPool):
+    """Drop-weight tests as plain JSON, run like single impacts (run_scenes, a SceneQueue):
     `per_scene` strikers side by side in each scene (drop_weight_scene), each scene run until
     its strikers are done or `max_time` (s) of simulated time (run_drop_weight)."""
     return {"test": "drop_weight", "material": str(material), "size": size,
@@ -160,10 +160,12 @@ def scene_counts(particles, per_scene):
                                                      if particles % per_scene else [])
 
 
-def workers_for(jobs, counts):
-    """How many worker processes run scenes of `counts` (scene_counts) with --jobs `jobs`: 0,
-    this process, for one scene or jobs <= 1 (a worker would only add YADE's start)."""
-    return min(jobs, len(counts)) if jobs > 1 and len(counts) > 1 else 0
+def on_workers(scheduler, counts):
+    """Whether scenes of `counts` (scene_counts) go to the workers of `scheduler` (a
+    process.scheduler.Scheduler, None: this process): not on local:1, nor one scene on this
+    machine (a worker would only add its start)."""
+    return (scheduler is not None and not scheduler.in_process
+            and not (len(counts) == 1 and scheduler.kind == "local"))
 
 
 def run_scenes(spec, which, event_log=None, on_scene=None, watch=None, materials=None):

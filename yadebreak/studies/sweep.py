@@ -33,6 +33,7 @@ from pathlib import Path
 
 from yadebreak.jobs.lifecycle import write_atomic
 from yadebreak.process.children import die_with_parent
+from yadebreak.process.scheduler import Scheduler, SchedulerError
 
 #: the exit code of a yadebreak script refusing its options (never retried)
 USER_ERROR = 2
@@ -40,8 +41,9 @@ USER_ERROR = 2
 OUT_ENV = "YADEBREAK_SWEEP_OUT"
 
 
-class SweepError(ValueError):
-    """A sweep that cannot start (bad table, scheduler, folder): one line for the user."""
+class SweepError(SchedulerError):
+    """A sweep that cannot start (bad table, folder; a scheduler's is its parent,
+    SchedulerError): one line for the user."""
 
 
 # -- the table ------------------------------------------------------------------------------------
@@ -227,46 +229,14 @@ def _error_line(log):
 
 
 # -- the scheduler ----------------------------------------------------------------------------------
-SCHEDULER_FORMS = "local, local:N (N workers), tcp://HOST:PORT, slurm or pbs"
-
-
 def connect(spec, jobqueue_options=None, jobs=1):
-    """A Dask Client for --scheduler `spec`: 'local' or 'local:N' (a LocalCluster of N
-    single-threaded workers; N defaults to the cores), 'tcp://HOST:PORT' (an existing scheduler),
-    'slurm' or 'pbs' (dask-jobqueue: a cluster of `jobs` batch jobs built with
-    `jobqueue_options`, e.g. {'cores': 1, 'memory': '2GB', 'walltime': '02:00:00'}). Returns
-    (client, cluster or None)."""
-    try:
-        from distributed import Client, LocalCluster
-    except ImportError:
-        raise SweepError("the sweep needs Dask: apt-get install python3-dask python3-distributed "
-                         "(make deps does)") from None
-    if spec == "local" or spec.startswith("local:"):
-        count = spec.partition(":")[2]
-        if count and not (count.isdigit() and int(count) >= 1):
-            raise SweepError(f"--scheduler = {spec}: N must be a whole number >= 1 (accepted: "
-                             f"{SCHEDULER_FORMS})")
-        workers = int(count) if count else (os.cpu_count() or 1)
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               dashboard_address=":0")
-        return Client(cluster), cluster
-    if spec.startswith("tcp://"):
-        try:
-            return Client(spec, timeout=30), None
-        except OSError as exc:
-            raise SweepError(f"--scheduler = {spec}: no scheduler answered ({exc})") from None
-    if spec in ("slurm", "pbs"):
-        try:
-            import dask_jobqueue
-        except ImportError:
-            raise SweepError(f"--scheduler = {spec} needs dask-jobqueue (pip install "
-                             "dask-jobqueue on the machine that starts the sweep)") from None
-        kind = dask_jobqueue.SLURMCluster if spec == "slurm" else dask_jobqueue.PBSCluster
-        options = {"cores": 1, "processes": 1, "memory": "2GB", **(jobqueue_options or {})}
-        cluster = kind(**options)
-        cluster.scale(jobs=jobs)
-        return Client(cluster), cluster
-    raise SweepError(f"--scheduler = {spec}: accepted {SCHEDULER_FORMS}")
+    """A Dask Client for --scheduler `spec` (process.scheduler: local, local:N, tcp://HOST:PORT,
+    slurm[:N], pbs[:N]; the sweep's --jobs is N where slurm or pbs names none), and what to close
+    after it: (client, closer or None)."""
+    scheduler = Scheduler.parse(spec)
+    if scheduler.kind in ("slurm", "pbs") and scheduler.workers is None:
+        scheduler = Scheduler(scheduler.kind, int(jobs))
+    return scheduler.connect(jobqueue_options)
 
 
 # -- the sweep ----------------------------------------------------------------------------------

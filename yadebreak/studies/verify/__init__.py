@@ -46,11 +46,11 @@ from the model's probability so that --broken particles break (fragmentation.par
 the 50 %; Fig. 11: 5 impacts, gamma 5 and 10; Figs. 13-19: 2 particles at 1000 J/kg, 2 % RT, 1
 in Fig. 15) (tests/test_verify.py). The whole command: docs/verification.md.
 Every run is a set of scenes (scenes.run_scenes of an impact_spec or, for the drop weight, a
-drop_weight_spec; Fig. 11: scenes.impact_scene and impact_again, in this process); the results are
-model.reports.breakage_result_of dicts, written to <out>/results.json with their settings. YADE
-runs in this process (the coupling makes it importable); --jobs > 1 runs the scenes in that many
-YADE processes kept for the whole command (scenes.ImpactPool), every figure's runs queued at the
-start, the costliest first.
+drop_weight_spec; Fig. 11 and the energy audit: a Task's calls); the results are
+model.reports.breakage_result_of dicts, written to <out>/results.json with their settings. With
+--scheduler local:1 (--jobs 1) YADE runs in this process (the coupling makes it importable);
+otherwise the scenes are Dask tasks of one scenes.SceneQueue kept for the whole command, every
+figure's runs queued at the start, the costliest first.
 """
 from __future__ import annotations
 
@@ -61,8 +61,8 @@ from yadebreak.model.materials import MaterialError
 from yadebreak.criteria import load_material
 from yadebreak.jobs.lifecycle import progress, tool_run
 from yadebreak.options.engine_flags import Derived, Override, engine_flag, options_from_flags
-from yadebreak.options.flags import (flag, integer, jobs_option, numbers, out_option,
-                                     overwrite_option, text)
+from yadebreak.options.flags import (flag, integer, numbers, out_option, overwrite_option,
+                                     scheduler_of, scheduler_options, text)
 from yadebreak.studies.verify import energy_audit, fragmentation, probability
 from yadebreak.studies.verify.report import write_report
 from yadebreak.studies.verify.settings import (PAPER_MATERIALS, Runner,  # noqa: F401
@@ -132,7 +132,7 @@ PARAMS = [
          "take the first", empty=False),
     *(engine_flag(name, OVERRIDES, "Figs. 13-19: " if name in FRAGMENTATION else "")
       for name in ("time_step_fraction", *FRAGMENTATION)),
-    jobs_option("YADE processes sharing each run's scenes"),
+    *scheduler_options("scenes"),
     out_option("out/verify"),
     overwrite_option(),
 ]
@@ -164,6 +164,7 @@ def verify(args):
         if bad:
             fail(f"--audit-energies = {args.audit_energies}: accepted 'target' or specific "
                  "energies > 0 J/kg, comma-separated")
+    scheduler = scheduler_of(args)
     if args.read_period not in ("every_step", "fast"):
         fail(f"--read-period = {args.read_period}: accepted every_step or fast")
     given = args.seeds
@@ -184,17 +185,34 @@ def verify(args):
             if getattr(args, "debug", False):
                 raise
             fail(f"--materials = {args.materials}: " + "; ".join(exc.problems))
+    earlier = _earlier_walls(out / "results.json")
     with tool_run(out, args):
-        runner = Runner(args.jobs)
+        runner = Runner(scheduler, args.retries)
         makers = [make for name, make in FIGURES.items() if name in wanted]
         try:
             runner.queue(plan(makers, args, out))     # every figure's runs, the costliest first
+            predicted = runner.wall_time(f"an earlier run's scene wall times in "
+                                         f"{out / 'results.json'}", earlier)
+            if predicted is not None:
+                progress(f"wall time, predicted: {predicted.line()}")
             figures = [make(args, runner, out) for make in makers]
         finally:
             runner.close()
-        write_report(out, figures, runner, args, time.time() - began)
+        told = runner.wall_time("this run's scenes")
+        write_report(out, figures, runner, args, time.time() - began, told)
+    if told is not None:
+        progress(f"wall time: {told.line()}")
     progress(f"wrote {out / 'report.md'} ({time.time() - began:.0f} s)")
     return 0
+
+
+def _earlier_walls(path):
+    """{run key: scene wall times} of an earlier verify's results.json (--overwrite 1), or {}."""
+    import json
+    try:
+        return json.loads(Path(path).read_text())["scene_walls"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return {}
 
 
 def main(argv):

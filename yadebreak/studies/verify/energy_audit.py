@@ -187,13 +187,13 @@ def _paper_options(args, time_step):
 
 #: an audited scene costs about this many of the same impact's scenes run as Fig. 16 runs them
 #: (every contact read every step; measured: granulite at 1000 J/kg, 75 s against 21 s): the
-#: place of its task in the pool's queue (settings.run_cost)
+#: place of its task in the queue (settings.run_cost)
 AUDIT_COST = 3.5
 
 
 def audit_task(name, energy, particles, seed, options):
     """The Task of `particles` particles of material `name` at `energy` (J/kg): scene k is
-    particle k (audit_scene), in a pool's worker or here."""
+    particle k (audit_scene), on a worker or here."""
     from yadebreak.studies.verify.settings import Run, Task, run_cost
     options = {**options, "global_damping": paper_material(name).global_damping}
     key = json.dumps(["energy_audit", name, energy, particles, seed, sorted(options.items())])
@@ -213,7 +213,7 @@ def audit_scene(spec, k):
 
 
 def audit_cases(runner, tasks):
-    """The combined audit of each task's particles (runner.run_tasks: a pool's workers take them
+    """The combined audit of each task's particles (runner.run_tasks: the workers take them
     with the other figures' scenes)."""
     results = []
     for task, audits in zip(tasks, runner.run_tasks(tasks)):

@@ -258,32 +258,52 @@ def figure_sizes(args, runner, out):
 
 
 # -- Fig. 11: repeated impacts -----------------------------------------------------------------
-def repeated(runner, material, size, energy, particles, impacts, seed, options):
-    """`particles` particles of `material` (a Material: its gamma) fired at `energy` (J/kg) on
-    steel `impacts` times (scenes.impact_again); the broken leave the test. Returns the broken
-    fraction after each impact, kept in runner.results."""
+def repeated(runner, materials, size, energy, particles, impacts, seed, options):
+    """`particles` particles of each of `materials` (Materials: their gammas) fired at `energy`
+    (J/kg) on steel `impacts` times, each material a Task of one scene (repeated_scene: on a
+    worker with the other figures' scenes, or here); the broken leave the test. Returns each
+    material's broken fraction after each impact, kept in runner.results."""
+    from yadebreak.studies.verify.settings import Run, Task, run_cost
+    tasks = []
+    for material in materials:
+        key = json.dumps(["repeated", material.name, material.params.gamma, size, energy,
+                          particles, impacts, seed, sorted(options.items())])
+        spec = {"task": f"{__name__}:repeated_scene", "counts": [particles],
+                "material": material.source, "gamma": material.params.gamma, "size": size,
+                "energy": energy, "impacts": impacts, "seed": seed, "options": options}
+        like = Run(material.name, size, [energy], particles, (seed,), options)
+        tasks.append(Task(key, spec, impacts * run_cost(like, energy)))
+    results = []
+    for material, task, (done,) in zip(materials, tasks, runner.run_tasks(tasks)):
+        if task.key not in runner.results:
+            runner.results[task.key] = {
+                "test": "repeated", "material": material.name, "gamma": material.params.gamma,
+                "size": size, "specific_energy": energy, "particles": particles,
+                "broken_fraction_after": done["fractions"], "scenes_at_step_limit": 0,
+                "options": options, "seed": seed, "wall_s": done["wall_s"]}
+            progress(f"{material.name} {1e3 * size:g} mm, gamma {material.params.gamma:g}: "
+                     f"{100 * done['fractions'][-1]:.0f} % broken after {impacts} impacts "
+                     f"({done['wall_s']:.0f} s)")
+        results.append(runner.results[task.key])
+    return results
+
+
+def repeated_scene(spec, k):
+    """The one scene of a repeated-impact Task (scenes.impact_again, `impacts` times): the
+    broken fraction after each impact and the seconds it took."""
     from yadebreak import scenes
     from yadebreak.scenes import view
-    key = json.dumps(["repeated", material.name, material.params.gamma, size, energy, particles, impacts,
-                      seed, sorted(options.items())])
-    if key not in runner.results:
-        began = time.time()
-        speed = float(np.sqrt(2.0 * energy))
-        brk, ids = scenes.impact_scene(material, size, [speed] * particles, seed=seed, **options)
-        home = {i: view.position(i) for i in ids}
-        alive, fractions = list(ids), []
-        for _ in range(impacts):
-            alive = scenes.impact_again(brk, alive, home, speed)
-            fractions.append(1 - len(alive) / particles)
-        runner.results[key] = {"test": "repeated", "material": material.name,
-                               "gamma": material.params.gamma, "size": size, "specific_energy": energy,
-                               "particles": particles, "broken_fraction_after": fractions,
-                               "scenes_at_step_limit": 0, "options": options, "seed": seed,
-                               "wall_s": time.time() - began}
-        progress(f"{material.name} {1e3 * size:g} mm, gamma {material.params.gamma:g}: "
-                 f"{100 * fractions[-1]:.0f} % broken after {impacts} impacts "
-                 f"({time.time() - began:.0f} s)")
-    return runner.results[key]
+    began = time.time()
+    material = paper_material(spec["material"]).with_params(gamma=spec["gamma"])
+    particles, speed = spec["counts"][k], float(np.sqrt(2.0 * spec["energy"]))
+    brk, ids = scenes.impact_scene(material, spec["size"], [speed] * particles,
+                                   seed=spec["seed"], **spec["options"])
+    home = {i: view.position(i) for i in ids}
+    alive, fractions = list(ids), []
+    for _ in range(spec["impacts"]):
+        alive = scenes.impact_again(brk, alive, home, speed)
+        fractions.append(1 - len(alive) / particles)
+    return {"fractions": fractions, "wall_s": time.time() - began}
 
 
 def figure_repeated(args, runner, out):
@@ -299,9 +319,9 @@ def figure_repeated(args, runner, out):
     fig, ax = plt.subplots(figsize=(10, 5.2))
     rows, checks = [], []
     number = np.arange(1, impacts + 1)
-    for k, factor in enumerate(factors):
-        mat = base.with_params(gamma=factor * base.params.gamma)
-        r = repeated(runner, mat, REPEATED_SIZE, REPEATED_ENERGY, n, impacts, args.seed, options)
+    mats = [base.with_params(gamma=factor * base.params.gamma) for factor in factors]
+    runs = repeated(runner, mats, REPEATED_SIZE, REPEATED_ENERGY, n, impacts, args.seed, options)
+    for k, (mat, r) in enumerate(zip(mats, runs)):
         model = mat.criterion.repeated_broken_fraction(share * REPEATED_ENERGY, REPEATED_SIZE,
                                                        impacts)
         sigma = np.sqrt(model * (1 - model) / n)

@@ -32,9 +32,10 @@ def table(header, rows):
     return "\n".join(lines)
 
 
-def write_report(out, figures, runner, args, wall):
+def write_report(out, figures, runner, args, wall, told=None):
     """report.md (a summary of the checks met, then each figure: plot, settings, table, checks)
-    and results.json (every figure's entry and every run's result)."""
+    and results.json (every figure's entry, every run's result, the scenes' wall times and
+    `told`, the jobs.wall_time.WallTime predicted from them)."""
     checks = [c for f in figures for c in f["checks"]]
     met = sum(bool(c["ok"]) for c in checks)
     lines = ["# The paper's Section 4.1 verification", "",
@@ -42,6 +43,8 @@ def write_report(out, figures, runner, args, wall):
              f"({'quick subset' if args.quick else 'the figures asked for'}). Model lines: "
              "docs/model.md; settings under each figure.", "",
              f"**Checks met: {met} of {len(checks)}.**", ""]
+    if told is not None:
+        lines += [f"Wall time: {told.line()}.", ""]
     lines += [f"- {f['name']}: {sum(bool(c['ok']) for c in f['checks'])} of {len(f['checks'])}"
               for f in figures]
     lines.append("")
@@ -55,4 +58,7 @@ def write_report(out, figures, runner, args, wall):
     write_atomic(out / "report.md", "\n".join(lines))
     write_atomic(out / "results.json", json.dumps(
         {"argv": args.argv, "wall_s": wall, "figures": figures,
-         "runs": list(runner.results.values())}, indent=1, default=float))
+         "runs": list(runner.results.values()),
+         "wall_time": None if told is None else told.to_dict(),
+         "scene_walls": {key: runner.walls[key] for key in runner.order if key in runner.walls}},
+        indent=1, default=float))

@@ -11,6 +11,7 @@ import numpy as np
 
 from yadebreak.criteria import load_material
 from yadebreak.analysis import reports
+from yadebreak.jobs import wall_time
 from yadebreak.jobs.lifecycle import progress, status
 from yadebreak.options.engine_flags import OPTION, Override
 
@@ -81,7 +82,7 @@ def paper_options(time_step, **more):
 @dataclasses.dataclass(frozen=True)
 class Task:
     """Scenes that are calls, not impacts: scene k is function(spec, k) for spec["task"] =
-    "module:function" and len(spec["counts"]) scenes, in a pool's worker or here. `cost` orders
+    "module:function" and len(spec["counts"]) scenes, on a worker or here. `cost` orders
     the queue with the impacts' (run_cost)."""
 
     key: str
@@ -89,23 +90,25 @@ class Task:
     cost: float
 
     def call(self, k):
-        from yadebreak.scenes.impact_pool import call_task
+        from yadebreak.scenes.queue import call_task
         return call_task(self.spec, k)
 
 
 class Runner:
-    """Runs impacts once per key (figures share runs) and keeps every result. With jobs > 1 the
-    single-impact scenes go to one pool of YADE workers kept for the whole command
-    (scenes.ImpactPool), queued the costliest first: queue() takes every figure's runs at the
-    start (plan() finds them), run_all those of one figure, so that no worker idles while
-    another ends a run. close() stops the pool."""
+    """Runs impacts once per key (figures share runs) and keeps every result. On a `scheduler`
+    with workers (process.scheduler.Scheduler; local:1 runs here) the scenes go to one
+    scenes.SceneQueue kept for the whole command, the costliest first: queue() takes every
+    figure's runs at the start (plan() finds them), run_all those of one figure, so that no
+    worker idles while another ends a run. close() lets the workers go."""
 
-    def __init__(self, jobs):
-        self.jobs = jobs
+    def __init__(self, scheduler, retries=1):
+        self.scheduler, self.retries = scheduler, retries
         self.results = {}
         self.returned = {}                     # Task key -> what its scenes returned
-        self._pool = None
-        self._queued = {}                      # run key -> its scenes in the pool
+        self._queue = None
+        self._queued = {}                      # run key -> its scenes in the queue
+        self.order = []                        # every run key (of one seed) in queue order
+        self.walls = {}                        # run key -> its scenes' wall times (s)
 
     def run(self, run):
         return self.run_all([run])[0]
@@ -121,14 +124,15 @@ class Runner:
         return [[self.results[run.key(energy)] for energy in run.energies] for run in runs]
 
     def _pooled(self, run, energy):
-        """The tally of the run's scenes at `energy` over its seeds (in the pool, or here)."""
+        """The tally of the run's scenes at `energy` over its seeds (on the workers, or here)."""
         tally = None
         for seed in run.seeds:
             key = run.key(energy, seed)
             if key in self._queued:
-                one = self._pool.collect(self._queued.pop(key), on_wait=_waiting(run, energy))
+                one = self._queue.collect(self._queued.pop(key), on_wait=_waiting(run, energy))
             else:
                 one = _tally_here(run, energy, seed)
+            self.walls[key] = list(one.scene_walls)
             if tally is None:
                 tally = one
             else:
@@ -143,36 +147,50 @@ class Runner:
             if task.key in self.returned:
                 continue
             if task.key in self._queued:
-                self.returned[task.key] = self._pool.collect(self._queued.pop(task.key))
+                self.returned[task.key] = self._queue.collect(self._queued.pop(task.key),
+                                                              on_wait=_waiting(task, None))
             else:
                 self.returned[task.key] = [task.call(k) for k in range(len(task.spec["counts"]))]
+            self.walls[task.key] = [r["wall_s"] for r in self.returned[task.key]]
         return [self.returned[task.key] for task in tasks]
 
     def queue(self, runs):
-        """Send the scenes of `runs` (Runs and Tasks) to the pool now (with jobs > 1), the
-        costliest first."""
-        if self.jobs <= 1:
-            return
+        """Send the scenes of `runs` (Runs and Tasks) to the workers now (if any), the costliest
+        first; their keys join `order` (what the wall time is predicted from)."""
         impacts = [r for r in runs if not isinstance(r, Task)]
         todo = [(key, run_cost(run, energy), (run, energy, seed))
                 for key, (run, energy, seed) in _each(impacts).items()]
         todo += [(t.key, t.cost, t) for t in runs if isinstance(t, Task)]
         for key, _, what in sorted(todo, key=lambda item: -item[1]):
-            if key in self.results or key in self.returned or key in self._queued:
+            if key in self.order:
                 continue
-            spec = what.spec if isinstance(what, Task) else _spec(*what)
-            self._queued[key] = self._pool_of().submit(spec)
+            self.order.append(key)
+            if not self.scheduler.in_process:
+                spec = what.spec if isinstance(what, Task) else _spec(*what)
+                self._queued[key] = self._queue_of().submit(spec)
+
+    def wall_time(self, source, walls=None):
+        """The WallTime of the runs queued so far (jobs/wall_time.py: one stage, every run's
+        scenes a set, in queue order) from `walls` ({run key: scene wall times}; default this
+        command's own), None where a run's are missing."""
+        walls = self.walls if walls is None else walls
+        if not self.order or any(key not in walls for key in self.order):
+            return None
+        count = self.scheduler.count
+        return wall_time.predict([[list(walls[key]) for key in self.order]], source,
+                                 (*wall_time.WORKERS, 4, 16, *([count] if count else [])))
 
     def close(self):
-        if self._pool is not None:
-            self._pool.close()
-            self._pool = None
+        if self._queue is not None:
+            self._queue.close()
+            self._queue = None
 
-    def _pool_of(self):
-        if self._pool is None:
-            from yadebreak import scenes
-            self._pool = scenes.ImpactPool(self.jobs)
-        return self._pool
+    def _queue_of(self):
+        if self._queue is None:
+            from yadebreak.scenes.queue import SceneQueue
+            progress(f"scenes on {self.scheduler}")
+            self._queue = SceneQueue(self.scheduler, self.retries)
+        return self._queue
 
     def _keep(self, run, energy, tally):
         mat, steel = paper_material(run.material), load_material(run.target)
@@ -199,7 +217,7 @@ class Runner:
 
 class Planner:
     """Stands for the Runner in a figure's first lines to learn which runs it asks for (plan):
-    run_all and results stop the figure there."""
+    run_all and run_tasks stop the figure there."""
 
     class Asked(Exception):
         pass
@@ -218,9 +236,6 @@ class Planner:
         self.runs += tasks
         raise Planner.Asked
 
-    @property
-    def results(self):                         # a figure run in this process (Fig. 11)
-        raise Planner.Asked
 
 
 def plan(figures, args, out):
@@ -260,13 +275,15 @@ DROP_WEIGHT_COST = 4.0
 
 
 def _waiting(run, energy):
-    """A progress line while a run's scenes wait in the pool behind costlier ones."""
+    """A progress line while a run's (or a Task's, energy None) scenes wait on the workers
+    behind costlier ones."""
     began = time.time()
+    what = (json.loads(run.key)[0].replace("_", " ") if energy is None else
+            f"{run.material} {1e3 * run.size:g} mm {energy:g} J/kg")
 
-    def line(started, submitted):
-        status(f"waiting for {run.material} {1e3 * run.size:g} mm {energy:g} J/kg: "
-                 f"{started} of {submitted} scenes of the command started "
-                 f"({time.time() - began:.0f} s)")
+    def line(done, submitted):
+        status(f"waiting for {what}: {done} of {submitted} scenes of the command done "
+               f"({time.time() - began:.0f} s)")
     return line
 
 
@@ -275,8 +292,8 @@ DROP_WEIGHT_MAX_TIME = 0.05
 
 
 def _spec(run, energy, seed):
-    """The run's scenes at `energy` of `seed` as a spec of scenes.run_scenes (a pool's or this
-    process's)."""
+    """The run's scenes at `energy` of `seed` as a spec of scenes.run_scenes (a worker's or
+    this process's)."""
     from yadebreak import scenes
     if run.test == "drop_weight":
         return scenes.drop_weight_spec(run.material, run.size, energy, run.particles,
@@ -288,7 +305,7 @@ def _spec(run, energy, seed):
 
 
 def _tally_here(run, energy, seed):
-    """A run's scenes of one seed in this process (jobs 1): the same tally as the pool's."""
+    """A run's scenes of one seed in this process (local:1): the same tally as the workers'."""
     from yadebreak import scenes
     spec = _spec(run, energy, seed)
     tally, _ = scenes.run_scenes(spec, range(len(spec["counts"])))
