@@ -43,7 +43,7 @@ class SceneQueue:
     def __init__(self, scheduler, retries=1):
         self.scheduler, self.retries = scheduler, int(retries)
         self._client = self._closer = self._finished = None
-        self._pending = {}                    # future -> (its set, scene, attempt)
+        self._pending = {}                    # future -> (its set, scenes, attempt, place)
         self._submitted = self._done = self._tasks = 0
 
     def __enter__(self):
@@ -104,14 +104,16 @@ class SceneQueue:
             self._client, self._closer = self.scheduler.connect()
             self._finished = as_completed()   # told by the client's callbacks: no polling
 
-    def _send(self, scene_set, scenes, attempt):
-        # priority: the order of submission (Dask runs the higher first)
+    def _send(self, scene_set, scenes, attempt, place=None):
+        # priority: the place in the order of submission, kept by a retry (Dask runs the higher
+        # first)
+        place = self._tasks if place is None else place
         future = self._client.submit(run_scenes_task, scene_set.spec, scenes, pure=False,
-                                     priority=-self._tasks,
-                                     key=f"yadebreak-scenes-{self._tasks}-{attempt}")
-        self._pending[future] = (scene_set, scenes, attempt)
+                                     priority=-place,
+                                     key=f"yadebreak-scenes-{place}-{attempt}")
+        self._pending[future] = (scene_set, scenes, attempt, place)
         self._finished.add(future)
-        self._tasks += 1
+        self._tasks += attempt == 1
         self._submitted += len(scenes) if attempt == 1 else 0
 
     def _harvest(self):
@@ -120,7 +122,7 @@ class SceneQueue:
             time.sleep(POLL_S)
             return
         for future in self._finished.next_batch(block=False):
-            scene_set, scenes, attempt = self._pending.pop(future)
+            scene_set, scenes, attempt, place = self._pending.pop(future)
             try:
                 for k, returned in zip(scenes, future.result()):
                     scene_set.keep(k, returned)
@@ -133,7 +135,7 @@ class SceneQueue:
                         f"{self.retries}); the scenes done are kept in "
                         f"{scene_set.folder or 'memory only'}: {type(exc).__name__}: {exc}") \
                         from exc
-                self._send(scene_set, scenes, attempt + 1)
+                self._send(scene_set, scenes, attempt + 1, place)
             future.release()                # its result lives here now: never computed again
 
 
