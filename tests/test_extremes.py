@@ -43,3 +43,22 @@ def test_a_case_filter_that_matches_nothing_is_refused_in_one_line(tmp_path, cap
     assert len(lines) == 1 and lines[0].startswith("[yadebreak] error: --only = nosuchcase: no "
                                                    "case's name holds it; the cases: ")
     assert "Ab-T10, S x 1e-3" in lines[0] and not (tmp_path / "out").exists()
+
+
+def test_the_matrix_run_as_a_units_job_gives_each_case_s_own_run(scene, tmp_path, capsys):
+    """scripts/extremes.py's run (a skeleton.Units job, one case per unit) on two fast cases:
+    extremes.json holds what run_case gives each alone, to the last digit (but the time taken),
+    the table is printed, and the run is marked finished."""
+    import argparse
+    import json
+    from yadebreak.jobs import extremes
+    args = argparse.Namespace(only="gamma = ", fast=True, out=str(tmp_path / "out"))
+    assert extremes.run(args) == 0
+    rows = json.loads((tmp_path / "out" / "extremes.json").read_text())
+    alone = [extremes.run_case(c, fast=True) for c in extremes.cases() if "gamma = " in c.name]
+    assert [r["case"] for r in rows] == ["gamma = 0.5", "gamma = 50"]
+    assert ([{k: v for k, v in r.items() if k != "wall_s"} for r in rows]
+            == [json.loads(json.dumps({k: v for k, v in r.items() if k != "wall_s"}))
+                for r in alone])
+    assert "| gamma = 50 |" in capsys.readouterr().out
+    assert (tmp_path / "out" / "finished.json").is_file()

@@ -61,3 +61,16 @@ def test_single_impacts_report_their_scenes_and_predict_a_rerun(scene, tmp_path,
     err = capsys.readouterr().err
     assert err.startswith("[yadebreak] wall time, predicted: 4 scenes"), err[:500]
     assert "an earlier run's scene wall times in" in err.splitlines()[0]
+
+
+def test_scenes_go_out_in_tasks_of_consecutive_scenes_as_the_queue_sends_them():
+    """64 scenes of 1 s on 2 workers go out in tasks of 4 (at least 8 tasks per worker): 32 s;
+    on 1 worker the process runs them itself (64 s); sets queued together (verify) are each cut
+    into their own tasks: a set of 3 s and one of 1 s on 2 workers end together at 3 s."""
+    from yadebreak.process.scheduler import TASKS_PER_WORKER, chunk_size
+    assert chunk_size(64, 2) == 64 // (TASKS_PER_WORKER * 2) == 4
+    assert wall_time.tasks([1.0] * 64, 2) == [4.0] * 16
+    got = wall_time.predict([[1.0] * 64], "test", (1, 2))
+    assert got.predicted_s == {1: 64.0, 2: 32.0} and got.scenes == 64
+    sets = wall_time.predict([[[3.0], [1.0]]], "test", (1, 2))
+    assert sets.predicted_s == {1: 4.0, 2: 3.0} and (sets.scenes, sets.longest_s) == (2, 3.0)

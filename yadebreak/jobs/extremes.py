@@ -22,7 +22,8 @@ from yadebreak import engine, scenes
 from yadebreak.engine import attach
 from yadebreak.scenes import extremes as extreme_scenes, view
 from yadebreak.criteria import load_material
-from yadebreak.jobs.lifecycle import mark_finished, progress
+from yadebreak.jobs import skeleton
+from yadebreak.jobs.lifecycle import progress
 from yadebreak.options.flags import fail
 
 SIZE = 5.5e-3
@@ -187,36 +188,45 @@ def run_case(case, fast=False):
 
 def run(args):
     """The matrix (args.only: the cases whose name holds it; args.fast: the test suite's particle
-    counts): a table on stdout, and extremes.md, extremes.csv and extremes.json in args.out.
-    Returns the exit status: 1 if any case fails. No checkpoints or --resume: a case takes
-    seconds and the matrix is run whole."""
-    chosen = [case for case in cases() if not args.only or args.only in case.name]
+    counts): a table on stdout, and extremes.md, extremes.csv and extremes.json in args.out (of
+    the cases done, if the run fails). Returns the exit status: 1 if any case fails. A
+    skeleton.Units job of one case per unit, not resumable: a case takes seconds and the matrix is
+    run whole."""
+    chosen = {case.name: case for case in cases() if not args.only or args.only in case.name}
     if not chosen:
         fail(f"--only = {args.only}: no case's name holds it; the cases: "
              + "; ".join(case.name for case in cases()))
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    rows = []
-    start = time.time()
-    for case in chosen:
-        r = run_case(case, fast=args.fast)
-        rows.append(r)
-        progress(f"{case.name}: {'ok' if r['ok'] else 'FAILED'}, {r['breakages']} breakages, "
+    start, rows = time.time(), []
+
+    def compute(k, name):
+        r = run_case(chosen[name], fast=args.fast)
+        progress(f"{name}: {'ok' if r['ok'] else 'FAILED'}, {r['breakages']} breakages, "
                  f"{r['steps']} steps, {r['wall_s']:.1f} s")
-    table = _table(rows)
-    print(table)
-    (out / "extremes.md").write_text(table + "\n")
+        return None, r
+
+    def write(done, end_reason, end_message):
+        rows[:] = done
+        if done:
+            _write_tables(out, done)
+
+    skeleton.run(skeleton.Units(args, list(chosen), compute, write, resumable=False))
+    print(_table(rows))
+    failed = [r["case"] for r in rows if not r["ok"]]
+    progress(f"{len(rows) - len(failed)} of {len(rows)} cases ok in {time.time() - start:.0f} s; "
+             f"wrote {out / 'extremes.md'}" + (f"; FAILED: {failed}" if failed else ""))
+    return 1 if failed else 0
+
+
+def _write_tables(out, rows):
+    """extremes.md, extremes.csv and extremes.json of `rows`."""
+    (out / "extremes.md").write_text(_table(rows) + "\n")
     with open(out / "extremes.csv", "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(rows[0]))
         writer.writeheader()
         for r in rows:
             writer.writerow({k: (";".join(v) if isinstance(v, list) else v) for k, v in r.items()})
     (out / "extremes.json").write_text(json.dumps(rows, indent=2))
-    failed = [r["case"] for r in rows if not r["ok"]]
-    mark_finished(out, args)
-    progress(f"{len(rows) - len(failed)} of {len(rows)} cases ok in {time.time() - start:.0f} s; "
-             f"wrote {out / 'extremes.md'}" + (f"; FAILED: {failed}" if failed else ""))
-    return 1 if failed else 0
 
 
 def _table(rows):

@@ -25,6 +25,8 @@ from yadebreak.jobs import paraview, skeleton, wall_time
 from yadebreak.jobs.lifecycle import (Heartbeat, Remaining, ScriptError, progress,
                                        resume_arguments, save_figure, status, write_atomic)
 from yadebreak.jobs import options as job_options
+from yadebreak.process.scheduler import SchedulerError
+from yadebreak.process.signals import stop_point
 
 
 def _energies(args):
@@ -107,7 +109,10 @@ def _queue(args):
                                                            args.scene_particles)):
         return contextlib.nullcontext()
     progress(f"scenes on {scheduler}")
-    return scenes.SceneQueue(scheduler, args.retries)
+    try:
+        return scenes.SceneQueue(scheduler, args.retries).start()
+    except SchedulerError as exc:
+        raise ScriptError(str(exc)) from None
 
 
 def _impacts_at(args, mat, target, k, energy, out, start, queue=None):
@@ -208,6 +213,7 @@ def _drop_at(args, mat, steel, k, energy, out):
     # until every striker rebounds (or max_time of simulated time); then open events close
     while any(view.velocity(s)[2] < 0 for s in strikers) and view.now() < args.max_time:
         engine.run_steps(500)
+        stop_point()                  # SIGINT, SIGTERM: end here (skeleton.run's stop points)
     stopped = any(view.velocity(s)[2] < 0 for s in strikers)
     brk.finish()
     result = reports.breakage_result(brk, ids, mat, args.size, energy, steel)

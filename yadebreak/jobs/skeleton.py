@@ -21,9 +21,9 @@ end writes the outputs, the finish marker, and removes the checkpoint.
 
     summary = skeleton.run(Drop(args))
 
-Jobs of independent units (the energies of single impacts and drop-weight tests) go through
-`run_units`, which keeps each finished unit in <out>/partial.json (PartialResults): --resume 1
-skips them.
+A job of independent units (the energies of single impacts and drop-weight tests, the stability
+matrix's cases) is a `Units` job, run by the same run(): one unit per advance(), each finished
+unit kept in <out>/partial.json (PartialResults) where --resume 1 skips it (`run_units`).
 """
 import math
 import time
@@ -52,6 +52,11 @@ class Job:
         self.quiet = quiet
 
     # -- start ----------------------------------------------------------------------------------
+    def start(self):
+        """A fresh run (build), or --resume 1 from the checkpoint (resume); returns the run's
+        wall time (s) before this invocation."""
+        return _start(self)
+
     def check(self):
         """Cross-checks of the options, before anything is written (raise ScriptError)."""
 
@@ -137,7 +142,7 @@ def run(job):
     start = time.time()
     # SIGINT, SIGTERM from here on: the run ends at its loop's next safe point, checkpointed
     with stop_points():
-        wall_before = _start(job)
+        wall_before = job.start()
 
         def runtime():                            # s: the whole run's, over its invocations
             return wall_before + time.time() - start
@@ -206,29 +211,78 @@ def _loop(job, start, runtime):
                 return None
 
 
+class Units(Job):
+    """A job of independent units, each one advance(): compute(k, key) gives (the scene's
+    controller, the unit's result); write(results of the keys done, end_reason, end_message)
+    the outputs (also those of a failed run, with the units done; returns the summary);
+    limited(results) the end message if a unit stopped at a limit (end reason "time_limit"), else
+    "". With `resumable`, each unit's result is kept in <out>/partial.json as it finishes
+    (validate(key, result): see PartialResults), so that --resume 1 skips the units an
+    interrupted run finished (each must depend only on the arguments and its own seed); a signal
+    ends the run at the unit's next stop point. run() returns the last controller."""
+
+    report_every = math.inf           # each unit says its own lines
+    checkpoint_every = -1.0           # partial.json, written at each unit, is the checkpoint
+
+    def __init__(self, args, keys, compute, write, limited=None, validate=None, resumable=True):
+        super().__init__(args)
+        self.keys, self.compute, self.write = list(keys), compute, write
+        self.limited, self.validate, self.resumable = limited, validate, resumable
+        self.brk, self.message = None, ""
+
+    def start(self):
+        if self.resumable:
+            self.partial = PartialResults(self.out, self.args, self.validate)
+        else:
+            mark_started(self.out)
+            self.partial = _InMemory()
+        self.todo = iter(self.partial.todo(self.keys))
+        return 0.0
+
+    def advance(self):
+        k, key = next(self.todo, (None, None))
+        if key is None:
+            results = self.partial.ordered(self.keys)
+            self.message = self.limited(results) if self.limited is not None else ""
+            return "time_limit" if self.message else "finished"
+        self.brk, result = self.compute(k, key)
+        self.partial.add(key, result)         # --stop-after: ends here, as if killed
+        return None
+
+    def elapsed(self):
+        return len(self.partial.done)
+
+    def save(self, path, wall_s):
+        """partial.json holds every finished unit already."""
+
+    def end_message(self, ended):
+        return self.message
+
+    def outputs(self, end_reason, end_message, runtime_s):
+        return self.write(self.partial.ordered([key for key in self.keys
+                                                if str(key) in self.partial.done]),
+                          end_reason, end_message)
+
+    def result(self, summary):
+        return self.brk
+
+
+class _InMemory:
+    """The finished units of a run that is not resumed (PartialResults' interface)."""
+
+    def __init__(self):
+        self.done = {}
+
+    def todo(self, keys):
+        return list(enumerate(keys))
+
+    def ordered(self, keys):
+        return [self.done[str(key)] for key in keys]
+
+    def add(self, key, result):
+        self.done[str(key)] = result
+
+
 def run_units(args, keys, compute, write, limited=None, validate=None):
-    """A job of independent units (the energies of single impacts, drop-weight tests): each
-    unit's result kept in <out>/partial.json as it finishes, so that --resume 1 skips the units
-    an interrupted run finished (each must depend only on the arguments and its own seed).
-
-    compute(k, key): (the scene's controller, the unit's result); write(results of the keys
-    done, end_reason, end_message): the outputs (also those of a failed run, with the units done);
-    limited(results): the end message if a unit stopped at a limit (end reason "time_limit"),
-    else ""; validate(key, result): see PartialResults. Returns the last computed controller."""
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    partial = PartialResults(out, args, validate)
-    brk = None
-
-    def write_done(end_reason, end_message):
-        write(partial.ordered([key for key in keys if str(key) in partial.done]), end_reason,
-              end_message)
-
-    with partial_outputs_on_failure(write_done):
-        for k, key in partial.todo(keys):
-            brk, result = compute(k, key)
-            partial.add(key, result)
-    message = limited(partial.ordered(keys)) if limited is not None else ""
-    write_done("time_limit" if message else "finished", message)
-    partial.finish()                              # a later --resume 1 has nothing to do
-    return brk
+    """run() of a Units job (its arguments): the last computed controller."""
+    return run(Units(args, keys, compute, write, limited, validate))

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from decimal import Decimal
 
 from yadebreak.model.intervals import PARTICLE_SIZE, Interval
-from yadebreak.process.scheduler import FORMS, SchedulerError, chosen, usable_cores
+from yadebreak.process.scheduler import FORMS, SchedulerError, chosen
 
 #: unit of an option -> the units accepted after a number, with their factor to that unit
 UNITS = {

@@ -31,6 +31,7 @@ import time
 from pathlib import Path
 
 from yadebreak.process.scheduler import chunk_size
+from yadebreak.process.signals import stop_point
 
 #: how often the parent looks for finished scenes (s): a scene takes 0.05 s at the least
 POLL_S = 0.05
@@ -51,6 +52,12 @@ class SceneQueue:
 
     def __exit__(self, *exc):
         self.close()
+
+    def start(self):
+        """Connect now, so that a scheduler that does not answer stops the command before its
+        first scene (SchedulerError); returns the queue."""
+        self._connect()
+        return self
 
     @property
     def workers(self):
@@ -79,6 +86,7 @@ class SceneQueue:
         than `retries` times stops the command with its error."""
         reported, told, merged = 0, time.time(), 0.0
         while len(scene_set.done) < scene_set.scenes:
+            stop_point()                    # SIGINT, SIGTERM in a script: end here
             self._harvest()
             # the merge takes every scene so far: once a second at most (a core the workers need)
             if (on_scene is not None and not scene_set.task and len(scene_set.done) > reported
