@@ -49,12 +49,7 @@ def timed(which, out, placement):
     subprocess.run(command(which, out, [*placement, "--overwrite", "1"]), check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, cwd=ROOT)
     wall = time.time() - start
-    return wall, sum(sum(stage) for stage in _flat(scene_walls(which, out)))
-
-
-def _flat(stages):
-    return [[d for one in stage for d in (one if isinstance(one, list) else [one])]
-            for stage in stages]
+    return wall, wall_time.predict(scene_walls(which, out), "", (1,)).sum_s
 
 
 class TcpCluster:

@@ -25,8 +25,8 @@ def one_openmp_thread():
 
 def builtins_in_main():
     """YADE sets an engine's label by running `__builtins__.<label> = ...` in __main__; where
-    __main__ holds the builtins as a dict (a Dask worker's process), that fails: give it the
-    module, as a script's __main__ has."""
+    __main__ holds the builtins as a dict (a process started by multiprocessing's spawn), that
+    fails: give it the module, as a script's __main__ has."""
     import builtins
     main = sys.modules.get("__main__")
     if main is not None and getattr(main, "__builtins__", builtins) is not builtins:

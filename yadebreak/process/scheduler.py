@@ -15,17 +15,12 @@ from __future__ import annotations
 
 import os
 import subprocess
-import sys
 import tempfile
 from dataclasses import dataclass
-from pathlib import Path
 
-from yadebreak.process.children import die_with_parent
+from yadebreak.process.children import python_module
 
 FORMS = "local, local:N (N workers), tcp://HOST:PORT, slurm[:N] or pbs[:N] (N batch jobs)"
-#: how long a new local cluster may take to say its address (s)
-START_S = 120.0
-
 
 #: a set of scenes goes out in at least this many tasks per worker (chunk_size): enough that
 #: the last tasks of a set, of unequal cost, still spread over the workers
@@ -134,25 +129,22 @@ def usable_cores():
 
 class LocalCluster:
     """A Dask LocalCluster of `workers` single-threaded worker processes, run by a plain-Python
-    child (local_cluster.py) that ends with this process or close(). Its log is kept in a
-    temporary file, shown if it fails to start."""
+    child (local_cluster.py) that ends with this process or close(). Its log is kept in an
+    unnamed temporary file, shown if it fails to start."""
 
     def __init__(self, workers):
-        self._log = tempfile.NamedTemporaryFile("w+", prefix="yadebreak-cluster-",
-                                                suffix=".log", delete=False)
-        package = str(Path(__file__).resolve().parents[2])
-        env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-            [package] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])}
-        self._proc = subprocess.Popen(
-            [_python(), "-m", "yadebreak.process.local_cluster", str(int(workers))],
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._log, text=True, env=env,
-            preexec_fn=die_with_parent)
+        self._log = tempfile.TemporaryFile("w+")       # gone with it, read if it fails
+        self._proc = python_module("yadebreak.process.local_cluster", str(int(workers)),
+                                   stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                   stderr=self._log, text=True)
         self.address = self._proc.stdout.readline().strip()
         if not self.address.startswith("tcp://"):
+            self._proc.wait()
+            self._log.seek(0)
+            said = self._log.read()[-800:]
             self.close()
             raise SchedulerError(f"--scheduler = local:{workers}: the cluster did not start: "
-                                 + Path(self._log.name).read_text()[-800:])
-        os.unlink(self._log.name)
+                                 + said)
 
     def close(self):
         if self._proc.poll() is None:
@@ -164,8 +156,3 @@ class LocalCluster:
                 self._proc.wait()
         self._log.close()
 
-
-def _python():
-    """The Python of this process, or Debian's under the yade launcher (whose sys.executable
-    is that same interpreter)."""
-    return sys.executable or "/usr/bin/python3"

@@ -106,12 +106,12 @@ def single_impacts(material, size, speed, particles, per_scene, seed, target="st
     with workers it is not called)."""
     spec = impact_spec(_named(material), size, speed, particles, per_scene, seed, _named(target),
                        max_steps, wait_for_arrivals, shape, **options)
-    if queue is None and on_workers(scheduler, spec["counts"]):
+    if queue is not None:
+        return queue.collect(queue.submit(spec, event_log), on_scene), None
+    if on_workers(scheduler, spec["counts"]):
         from yadebreak.scenes.queue import SceneQueue
         with SceneQueue(scheduler) as own:
             return own.collect(own.submit(spec, event_log), on_scene), None
-    if queue is not None:
-        return queue.collect(queue.submit(spec, event_log), on_scene), None
     if event_log is not None:
         Path(event_log).write_text("")
     return run_scenes(spec, range(len(spec["counts"])), event_log, on_scene, watch,

@@ -208,18 +208,11 @@ class SceneProcess:
     it is sent, one line of JSON each way; it dies with its worker."""
 
     def __init__(self):
-        import os
         import subprocess
-        import sys
-        from yadebreak.process.children import die_with_parent
-        package = str(Path(__file__).resolve().parents[2])
-        env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-            [package] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p])}
+        from yadebreak.process.children import python_module
         self._err = tempfile.TemporaryFile("w+")
-        self._proc = subprocess.Popen(
-            [sys.executable or "/usr/bin/python3", "-m", "yadebreak.jobs.scene_process"],
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._err, text=True, env=env,
-            preexec_fn=die_with_parent)
+        self._proc = python_module("yadebreak.jobs.scene_process", stdin=subprocess.PIPE,
+                                   stdout=subprocess.PIPE, stderr=self._err, text=True)
 
     def alive(self):
         return self._proc.poll() is None
@@ -240,8 +233,6 @@ def run_here(spec, scenes):
     """The scenes `scenes` of `spec` in this process, one after the other: for each,
     {"returned": what a task spec's function(spec, k) returned} or {"tally": its tally as a
     dict, "events": its event lines}."""
-    from yadebreak.adapter.yadepath import builtins_in_main
-    builtins_in_main()                      # a worker's __main__ may be any module
     if "task" in spec:
         return [{"returned": call_task(spec, k)} for k in scenes]
     from yadebreak.scenes.impacts import run_scenes
