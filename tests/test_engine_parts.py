@@ -289,6 +289,61 @@ def test_both_judge_paths_make_the_same_decisions(seed, at_peak):
     assert each == every
 
 
+def _reader_with_rows(rng, ids, cs):
+    """A ContactReader whose numpy block holds 60 random rows among the bodies `ids`."""
+    from yadebreak.engine.contacts.table import FIELDS
+    reader = ContactReader({}, cs, 1e-4)
+    a, b = rng.choice(ids, 60), rng.choice(ids, 60)
+    reader.table.set(a, b, rng.uniform(0.0, 1e-3, (len(FIELDS), 60)), [None] * 60, [None] * 60)
+    return reader
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_events_closed_together_are_those_closed_one_by_one(seed):
+    """close_events on a read's events at once (numpy) = on each in turn (criteria's unload on
+    floats): the same log, columns, offsets of the bodies' rows and weakened bodies, to the
+    last digit."""
+    results = []
+    for together in (True, False):
+        st, crits, _ = _scene(seed)
+        rng = np.random.default_rng(seed)
+        reader = _reader_with_rows(rng, np.array(sorted(st.tracked)), 0.3 * (seed % 2))
+        records, weakened = [], []
+        judge = judging.Judge(st, crits, reader, judging.Rules(1.0, 0.02),
+                              record=lambda kind, i, **f: records.append((kind, i, f)),
+                              weakened=weakened.extend)
+        closing = sorted(st.open_events)[::-1]            # logged in the order given
+        if together:
+            judge.close_events(closing)
+        else:
+            for i in closing:
+                judge.close_events([i])
+        results.append((records, weakened, sorted(st.open_events), reader.table.data.tolist(),
+                        json.dumps({k: v.tolist() for k, v in st.table.columns.items()})))
+    together, one_by_one = results
+    assert len(together[0]) >= 5 and together[1]        # damage logged, energies lowered
+    assert {"e_cum" in f for _, _, f in together[0]} == {True, False}   # both criteria
+    assert together == one_by_one
+
+
+def test_tracked_bodies_keep_their_mask_in_step_with_every_change():
+    from yadebreak.engine.state import TrackedBodies
+    tracked = TrackedBodies([1, 5])
+    tracked.mask(8)
+    changes = [lambda t: t.add(3), lambda t: t.add(9), lambda t: t.discard(5),
+               lambda t: t.discard(42), lambda t: t.update([0, 2]), lambda t: t.remove(0),
+               lambda t: t.__isub__({2}), lambda t: t.__ior__({6}), lambda t: t.pop(),
+               lambda t: t.difference_update([6]), lambda t: t.symmetric_difference_update({7})]
+    for change in changes:
+        change(tracked)
+        n = max(tracked, default=0) + 3
+        assert tracked.mask(n).nonzero()[0].tolist() == sorted(tracked)
+    copy = __import__("copy").copy(tracked)
+    copy.add(11)                                          # a copy has a mask of its own
+    assert 11 not in tracked.mask(12).nonzero()[0]
+    assert not tracked.mask(12).flags.writeable
+
+
 def test_docs_options_is_the_table_as_rendered_now():
     """docs/options.md is `python3 -m yadebreak options`: regenerate it when config.py changes."""
     import contextlib

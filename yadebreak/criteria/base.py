@@ -18,6 +18,7 @@ Engine side, on the columns of the engine's body table (engine/state.BodyTable),
     judge(table, ids, ek, specific) -> Judgement   which of the bodies read now break
     judge_one(columns, i, ek, specific) -> tuple   the same function on one body (scalars)
     unload(table, i) -> event fields or None        a stressing event ended without breakage
+    unload_all(table, ids) -> [fields or None]      the same for the events a read closes
     breakage(table, i, ek) -> (ratio, t10, extra)   the t10' of a breakage
     t10_at_threshold(table, i, threshold) -> t10    the t10' of a breakage right at the threshold
     force(table, i, ratio) -> ek                    a breakage imposed by break_body()
@@ -128,6 +129,12 @@ class Criterion:
     def judge(self, table, ids, ek, specific):
         """judge_one on the bodies `ids` (arrays), as a Judgement."""
         return Judgement(*self.judge_one(table.columns, ids, ek, specific))
+
+    def unload_all(self, table, ids):
+        """unload() of each body in `ids` (a list; each body's own columns only, so the order
+        does not matter): a criterion may do it at once (a collisional cloud closes hundreds of
+        events a read)."""
+        return [self.unload(table, i) for i in ids]
 
     def t10_at_threshold(self, table, i, threshold):
         """The t10' (%) body i would have had, broken at its threshold `threshold` (J/kg, its

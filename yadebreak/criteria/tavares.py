@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from yadebreak import model
 from yadebreak.criteria.base import Criterion
 from yadebreak.model.intervals import PARTICLE_SIZE, YOUNG_MODULUS
@@ -181,6 +183,27 @@ class Tavares(Criterion):
         c["fracture_energy"][i] = after
         c["damage"][i] = 1.0 - after / float(c["fracture_energy_initial"][i])
         return {"fracture_energy": before, "fracture_energy_after": after, "ratio": ratio}
+
+    def unload_all(self, table, ids):
+        """unload() of the bodies `ids` at once, with the same numbers: the columns gathered and
+        written with numpy, Eq. 6 solved body by body on floats as unload() solves it."""
+        c = table.columns
+        rows = np.asarray(ids, np.int64)
+        before = c["fracture_energy"][rows]
+        ratios = c["event_max"][rows] / (c["mass"][rows] * before)
+        damaged = (c["kind"][rows] == BREAKABLE).nonzero()[0]
+        gamma = self.params.gamma
+        energies, ratios = before.tolist(), ratios.tolist()
+        after = [model.weakened_fracture_energy(energies[k], ratios[k], gamma)
+                 for k in damaged.tolist()]
+        weakened, at = np.array(after, float), rows[damaged]
+        c["fracture_energy"][at] = weakened
+        c["damage"][at] = 1.0 - weakened / c["fracture_energy_initial"][at]
+        fields = [None] * len(rows)
+        for k, a in zip(damaged.tolist(), after):
+            fields[k] = {"fracture_energy": energies[k], "fracture_energy_after": a,
+                         "ratio": ratios[k]}
+        return fields
 
     def breakage(self, table, i, ek):
         """(ratio = Ek' / (m E), t10', {}): Eq. 8 at that ratio, with kappa_successive for

@@ -343,13 +343,11 @@ class Controller:
         cracked = sorted(i for i in state.open_events if i in state.tracked and c["cracked"][i])
         if cracked:
             self._break_all([(i, float(event_max[i]), None) for i in cracked])
-        closed = len(cracked)
-        for bid in list(state.open_events):
-            if bid in state.tracked and event_max[bid] > 0.0:
-                self.judge.close_event(bid)
-                closed += 1
+        ending = [bid for bid in state.open_events
+                  if bid in state.tracked and event_max[bid] > 0.0]
+        self.judge.close_events(ending)
         state.open_events.clear()
-        return closed
+        return len(cracked) + len(ending)
 
     def zero_overlaps(self):
         """Before the InteractionLoop (see zeroing.py)."""

@@ -308,6 +308,65 @@ def check_format(data):
                          f"reads version {FORMAT_VERSION}: run the scene again from its start")
 
 
+def _forgets_mask(name):
+    """set's method `name`, after which the mask is built anew when next asked."""
+    method = getattr(set, name)
+
+    def changed(self, *args):
+        result = method(self, *args)
+        self._mask = None
+        return result
+    changed.__name__ = name
+    return changed
+
+
+class TrackedBodies(set):
+    """The ids of the bodies the engine reads: a set that also keeps them as a mask by id, in
+    step with every change (a numpy read asks for it each read; built from the set it would
+    cost about 20 ns per body, 160 us a read at 8,000 bodies)."""
+
+    def __init__(self, ids=()):
+        super().__init__(ids)
+        self._mask = None
+
+    def add(self, i):
+        set.add(self, i)
+        mask = self._mask
+        if mask is not None:
+            if i < len(mask):
+                mask[i] = True
+            else:
+                self._mask = None
+
+    def discard(self, i):
+        set.discard(self, i)
+        mask = self._mask
+        if mask is not None and 0 <= i < len(mask):
+            mask[i] = False
+
+    def __reduce__(self):                    # a copy builds its own mask
+        return TrackedBodies, (list(self),)
+
+    def mask(self, n):
+        """Which of the ids 0 .. n-1 are tracked (a read-only view; n above every id)."""
+        mask = self._mask
+        if mask is None or len(mask) < n:
+            mask = np.zeros(n, bool)
+            if self:
+                mask[np.fromiter(self, np.int64, len(self))] = True
+            self._mask = mask
+        view = mask[:n]
+        view.flags.writeable = False
+        return view
+
+
+# every other change of the set: the mask is built anew when next asked
+for _name in ("remove", "pop", "clear", "update", "difference_update", "intersection_update",
+              "symmetric_difference_update", "__ior__", "__iand__", "__isub__", "__ixor__"):
+    setattr(TrackedBodies, _name, _forgets_mask(_name))
+del _name
+
+
 class EngineState:
     """Everything an engine knows about its bodies, as plain numbers: the body table, which
     bodies are tracked (breakable, or unbreakable awaiting their t10') and which have an open
@@ -316,7 +375,7 @@ class EngineState:
 
     def __init__(self, labels, seed, event_log=None, columns=None):
         self.table = BodyTable(labels, columns)
-        self.tracked = set()
+        self.tracked = TrackedBodies()
         self.open_events = set()
         self.log = EventLog(event_log)
         self.ledger = FinesLedger()
@@ -343,7 +402,7 @@ class EngineState:
         check_format(data)
         self = cls(data["table"]["labels"], 0, event_log)
         self.table = BodyTable.from_dict(data["table"], columns)
-        self.tracked = set(data["tracked"])
+        self.tracked = TrackedBodies(data["tracked"])
         # open events are those with an energy recorded (built in id order, as at any restore)
         event_max = self.table.columns["event_max"]
         self.open_events = {i for i in data["tracked"] if event_max[i] > 0.0}

@@ -42,12 +42,18 @@ class Tracking:
             if k == BREAKABLE:
                 self.smallest.push(float(radius[i]), i)
 
-    def weakened(self, i):
-        """A damage lowered body i's fracture energy: "fast" reads follow it."""
-        if self.reach is not None and i in self.state.tracked:
-            c = self.state.table.columns
-            self.reach.update(i, float(c["radius"][i]), float(c["fracture_energy"][i]),
-                              O.bodies[i].material)
+    def weakened(self, ids):
+        """A damage lowered the fracture energy of the bodies `ids` (a list): "fast" reads
+        follow them."""
+        if self.reach is None:
+            return
+        tracked = self.state.tracked
+        ids = [i for i in ids if i in tracked]
+        c = self.state.table.columns
+        bodies, update = O.bodies, self.reach.update
+        for i, radius, energy in zip(ids, c["radius"][ids].tolist(),
+                                     c["fracture_energy"][ids].tolist()):
+            update(i, radius, energy, bodies[i].material)
 
     def smallest_breakable(self):
         """(radius, id) of the smallest breakable body still tracked, None if none."""

@@ -23,6 +23,7 @@ from yadebreak.adapter.yade_api import Matrix3, O, Quaternion, Vector3, utils, w
 from yadebreak.engine import add_materials, attach
 from yadebreak.engine.contacts.volumetric import STEP_FRACTION
 from yadebreak.engine.shapes.polyhedron import skipped_turn
+from yadebreak.engine.state import TrackedBodies
 from yadebreak import model
 from yadebreak.model import placement
 from yadebreak.model.cells import convex_polyhedron, random_convex_vertices, sieve_size
@@ -351,7 +352,7 @@ def follow_impact(impact, max_steps=50000, read=True):
                 peaks[2] = max(peaks[2], 0.4 * i.phys.kno * max(i.geom.penetrationDepth, 0.0)
                                ** 2.5)
         if reader is not None:
-            reader.read(O.interactions, O.bodies, {impact.particle}, set(), O.time, 1)
+            reader.read(O.interactions, O.bodies, TrackedBodies([impact.particle]), set(), O.time, 1)
             peaks[1] = max(peaks[1], float(np.sum(reader.table.work)))
         peaks[0], peaks[3] = max(peaks[0], work), max(peaks[3], approach)
     rebound = float(utils.kineticEnergy())

@@ -31,9 +31,7 @@ class ArrayRead:
                  zeroing_changes=None):
         """One read; see ContactReader.read."""
         reader, table = self.reader, self.table
-        mask = np.zeros(len(bodies), bool)              # tracked, by body id
-        if tracked:
-            mask[np.fromiter(tracked, np.int64, len(tracked))] = True
+        mask = tracked.mask(len(bodies))                # tracked, by body id
         flags = None                                    # which rows are zeroed, asleep
         if not zeroed:
             self.zeroed_rows.forget()          # the changes told meanwhile are not followed
