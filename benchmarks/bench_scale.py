@@ -234,7 +234,8 @@ THREADS = {"1 thread": {"OMP_NUM_THREADS": "1"}, "2 threads": {"OMP_NUM_THREADS"
 def threads(sizes, repeats):
     """Part 7: one child process per THREADS entry (OpenMP reads its settings at start)."""
     print(f"\n7. The materials' own fracture energies (damage events, no breakage) under YADE's "
-          f"OpenMP threads: us per step, median of {repeats} (plain / default, ratio)")
+          f"OpenMP threads: us per step, median of {repeats} (plain / default, ratio of the "
+          f"medians, median of the ratios of runs made one after the other)")
     for n in sizes:
         for name, env in THREADS.items():
             child = subprocess.run(
@@ -243,21 +244,37 @@ def threads(sizes, repeats):
                 check=True)
             got = json.loads(child.stdout.strip().splitlines()[-1])
             print(f"  {n:7d} bodies, {name:18s}: " + "; ".join(
-                f"{kind} {r['plain']:8.1f} / {r['default']:8.1f} ({r['default'] / r['plain']:.2f}x, "
-                f"+{r['default'] - r['plain']:.0f} us, {r['damage']} damage events)"
-                for kind, r in got.items()))
+                f"{kind} {np.median(r['plain']):8.1f} / {np.median(r['default']):8.1f} "
+                f"({np.median(r['default']) / np.median(r['plain']):.2f}x, paired "
+                f"{np.median(np.divide(r['default'], r['plain'])):.2f}x, "
+                f"+{np.median(r['default']) - np.median(r['plain']):.0f} us, of which "
+                f"{np.median(r['own']):.0f} us in yadebreak's PyRunners, {r['damage']} damage "
+                f"events)" for kind, r in got.items()))
 
 
 def _threads_child(n, repeats):
     """Part 7 in this process: each scene in plain YADE and with the default, in turn; one JSON
-    line {kind: {plain, default: us per step, damage: events in the last default run}}."""
+    line {kind: {plain, default: us per step of each run, in turn; own: us per step inside
+    yadebreak's PyRunners in each default run (YADE's engine timing); damage: events in the last
+    default run}}."""
     out = {}
+    steps = steps_for(n)
     for kind in ("dense", "collisional"):
-        runs = {"plain": [], "default": []}
+        runs = {"plain": [], "default": [], "own": []}
         for _ in range(repeats):
-            for mode in runs:                     # the default last: its controller stays
-                runs[mode].append(rate(kind, n, mode, steps_for(n), breakable=True)[0])
-        out[kind] = {mode: float(np.median(v)) for mode, v in runs.items()}
+            for mode in ("plain", "default"):     # the default last: its controller stays
+                prepare(kind, n, mode, breakable=True)
+                gc.collect()
+                O.timingEnabled = True            # from here on: the timed steps only
+                t0 = time.perf_counter()
+                engine.run_steps(steps)
+                runs[mode].append(1e6 * (time.perf_counter() - t0) / steps)
+                O.timingEnabled = False
+                if mode == "default":
+                    runs["own"].append(1e-3 * sum(
+                        e.execTime for e in O.engines if isinstance(e, _w.PyRunner)
+                        and e.label.startswith("yadebreak")) / steps)
+        out[kind] = dict(runs)
         out[kind]["damage"] = sum(e["kind"] == "damage" for e in engine.controller_of().events)
     print(json.dumps(out))
 

@@ -12,7 +12,6 @@ an id and scalars or on ids and arrays) and give the same decisions and numbers
 from __future__ import annotations
 
 from dataclasses import dataclass
-from itertools import repeat
 
 import numpy as np
 
@@ -97,7 +96,12 @@ class Judge:
         loaded ones allow before the next read (None unless `fast`)."""
         # in id order: the decisions (and the random draws of breakages in one read) do not
         # depend on the order in which YADE or the reader met the contacts
-        candidates = sorted(self.state.open_events.union(loading.energy))
+        open_events = self.state.open_events
+        if loading.ids is None:                   # a read contact by contact: a few bodies
+            candidates = sorted(open_events.union(loading.energy))
+        else:
+            candidates = np.union1d(loading.ids, np.fromiter(open_events, np.int64,
+                                                             len(open_events))).tolist()
         if not candidates:
             return [], None
         plan_of = self.plan_each if len(candidates) <= self.small else self.plan_all
@@ -169,7 +173,7 @@ class Judge:
             if not paused.any():
                 paused = None
         active = known if paused is None else _within(~paused, known)
-        ek = np.fromiter(map(loading.energy.get, candidates, repeat(0.0, n)), float, n)
+        ek = loading.energies(ids)
         if self.carried:
             ek = ek + c["carried"][ids]
         if self.energy_factor != 1.0:
@@ -196,7 +200,7 @@ class Judge:
             c["specific_energy"][ids[active]] = specific[active]
         growing = ids[grows]
         c["event_max"][growing] = ek[grows]
-        c["event_partner"][growing] = list(map(loading.strongest.partner, growing.tolist()))
+        c["event_partner"][growing] = loading.strongest.partners(growing)
         need = np.full(n, NOTHING, np.int8)
         need[_within(event_max > 0.0, active)] = CLOSE_IF_UNLOADED
         need[grows] = OPEN

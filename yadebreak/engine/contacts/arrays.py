@@ -303,10 +303,9 @@ class ArrayRead:
         # each body's sum over its sides in their order (bincount adds in the order given)
         sums = np.bincount(owner, weights=values)[ids]
         heads = heads[values[heads] > 0.0]
-        # body -> (share, row, sign, partner), built in C: a cloud has hundreds of bodies
+        # (ids, share, row, sign, partner) as arrays: a cloud has hundreds of bodies, and most
+        # reads ask only for the partners of some
         row, side = row[heads], side[heads]
-        found = dict(zip(owner[heads].tolist(), zip(
-            values[heads].tolist(), row.tolist(), (1.0 - 2.0 * side).tolist(),
-            ids_of[::-1][side, row].tolist())))
-        return Loading(dict(zip(ids.tolist(), sums.tolist())),
-                       StrongestContacts(found, table.geoms), grew)
+        ranked = (owner[heads], values[heads], row, 1.0 - 2.0 * side, ids_of[::-1][side, row])
+        return Loading(strongest=StrongestContacts(geoms=table.geoms, ranked=ranked), grew=grew,
+                       ids=ids, sums=sums)

@@ -2,7 +2,10 @@
 whether any of its contacts still worked."""
 from __future__ import annotations
 
+from itertools import repeat
 from typing import NamedTuple
+
+import numpy as np
 
 from yadebreak.engine.contacts.table import SHARE_A, SHARE_B
 
@@ -16,30 +19,58 @@ class Strongest(NamedTuple):
     other: int            # the partner's body id (-1: none)
 
 
+def _places(ids, bodies):
+    """Where each of `bodies` (int64) is in the sorted `ids`, and whether it is there."""
+    if not len(ids):
+        return np.zeros(len(bodies), np.int64), np.zeros(len(bodies), bool)
+    at = np.minimum(np.searchsorted(ids, bodies), len(ids) - 1)
+    return at, ids[at] == bodies
+
+
 class StrongestContacts:
     """body -> its Strongest contact at a read; the normal is fetched from YADE only for the
-    bodies asked for."""
+    bodies asked for. A numpy read gives them as arrays (`ranked`: ids in order, shares, rows,
+    signs, partners), looked up body by body only when asked (a breakage): most reads ask only
+    for the partners of the bodies whose event grew, all at once (partners)."""
 
-    def __init__(self, found=None, geoms=None):
-        self._found = found or {}     # body -> (share, row, sign, other)
+    def __init__(self, found=None, geoms=None, ranked=None):
+        self._found = found if found is not None or ranked is not None else {}
+        self._ranked = ranked         # (ids, share, row, sign, other) arrays, ids sorted
         self._geoms = geoms
         self._made = {}
 
     def __setitem__(self, body, value):
         self._made[body] = value
 
+    def _by_body(self):
+        """body -> (share, row, sign, other)."""
+        if self._found is None:
+            self._found = dict(zip(self._ranked[0].tolist(),
+                                   zip(*(column.tolist() for column in self._ranked[1:]))))
+        return self._found
+
     def partner(self, body):
         """The partner's id of a body's strongest contact (-1: none), without YADE's normal."""
         made = self._made.get(body)
         if made is not None:
             return made.other
-        found = self._found.get(body)
+        found = self._by_body().get(body)
         return -1 if found is None else found[3]
+
+    def partners(self, bodies):
+        """partner() of each of `bodies` (an int64 array), as a list."""
+        if self._ranked is None or self._made:
+            return [self.partner(b) for b in bodies.tolist()]
+        ids, other = self._ranked[0], self._ranked[4]
+        if not len(ids):
+            return [-1] * len(bodies)
+        at, found = _places(ids, bodies)
+        return np.where(found, other[at], -1).tolist()
 
     def row(self, body):
         """(row, share column) of a body's strongest contact in the read's table (the column of
         the body's share, Eq. 4), None if the read did not rank it."""
-        found = self._found.get(body)
+        found = self._by_body().get(body)
         if found is None:
             return None
         return found[1], (SHARE_A if found[2] > 0.0 else SHARE_B)
@@ -47,7 +78,7 @@ class StrongestContacts:
     def get(self, body, default=None):
         made = self._made.get(body)
         if made is None:
-            found = self._found.get(body)
+            found = self._by_body().get(body)
             if found is None:
                 return default
             share, row, sign, other = found
@@ -56,12 +87,30 @@ class StrongestContacts:
 
 
 class Loading:
-    """The bodies' loading found by one read."""
+    """The bodies' loading found by one read. A numpy read gives the energies as arrays (`ids`
+    sorted, `sums`), made a dict only when asked (`energy`)."""
 
-    __slots__ = ("energy", "strongest", "grew")
+    __slots__ = ("_energy", "ids", "sums", "strongest", "grew")
 
-    def __init__(self, energy=None, strongest=None, grew=None):
-        self.energy = energy if energy is not None else {}   # body -> Ek' (J) counted now
+    def __init__(self, energy=None, strongest=None, grew=None, ids=None, sums=None):
+        self._energy = energy if energy is not None or ids is not None else {}
+        self.ids, self.sums = ids, sums
         self.strongest = strongest if strongest is not None else StrongestContacts()
         self.grew = grew if grew is not None else set()     # tracked bodies with a contact that
         #                                                       worked since the last read
+
+    @property
+    def energy(self):
+        """body -> Ek' (J) counted now."""
+        if self._energy is None:
+            self._energy = dict(zip(self.ids.tolist(), self.sums.tolist()))
+        return self._energy
+
+    def energies(self, bodies):
+        """Ek' (J) of each of `bodies` (an int64 array; 0.0 for a body without counted
+        energy)."""
+        if self.ids is None:
+            n = len(bodies)
+            return np.fromiter(map(self._energy.get, bodies.tolist(), repeat(0.0, n)), float, n)
+        at, found = _places(self.ids, bodies)
+        return np.where(found, self.sums[at], 0.0) if len(self.ids) else np.zeros(len(bodies))
