@@ -22,7 +22,10 @@ above it is yadebreak's own work. Prints microseconds per step and ratios measur
 --quick runs 1e3 and 1e4 bodies, --per-step-only part 1 alone. Part 7 (--threads-only: it alone)
 runs both scenes with the material's own fracture energies (damage events at 3 m/s, breakage out
 of reach) under YADE's OpenMP on 1 and 2 threads, and on 2 threads with OMP_WAIT_POLICY=PASSIVE
-(threads that sleep, not spin, while the engine's Python runs), each in a process of its own.
+(threads that sleep, not spin, while the engine's Python runs), each in a process of its own,
+with the median of the ratios of runs made one after the other (steadier than the ratio of the
+medians on a shared machine) and yadebreak's own time per step inside its PyRunners (YADE's engine
+timing): what it adds, apart from what it does to YADE's own engines.
 """
 import argparse
 import gc
