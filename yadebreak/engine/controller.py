@@ -343,8 +343,9 @@ class Controller:
         cracked = sorted(i for i in state.open_events if i in state.tracked and c["cracked"][i])
         if cracked:
             self._break_all([(i, float(event_max[i]), None) for i in cracked])
-        ending = [bid for bid in state.open_events
-                  if bid in state.tracked and event_max[bid] > 0.0]
+        # in id order, as a read judges: not in the order the set keeps, which its history sets
+        ending = sorted(bid for bid in state.open_events
+                        if bid in state.tracked and event_max[bid] > 0.0)
         self.judge.close_events(ending)
         state.open_events.clear()
         return len(cracked) + len(ending)
