@@ -251,19 +251,20 @@ def threads(sizes, repeats):
                 f"({np.median(r['default']) / np.median(r['plain']):.2f}x, paired "
                 f"{np.median(np.divide(r['default'], r['plain'])):.2f}x, "
                 f"+{np.median(r['default']) - np.median(r['plain']):.0f} us, of which "
-                f"{np.median(r['own']):.0f} us in yadebreak's PyRunners, {r['damage']} damage "
-                f"events)" for kind, r in got.items()))
+                f"{np.median(r['own']):.0f} us in yadebreak's PyRunners; YADE's engines "
+                f"{np.median(r['yade plain']):.0f} / {np.median(r['yade default']):.0f} us; "
+                f"{r['damage']} damage events)" for kind, r in got.items()))
 
 
 def _threads_child(n, repeats):
     """Part 7 in this process: each scene in plain YADE and with the default, in turn; one JSON
     line {kind: {plain, default: us per step of each run, in turn; own: us per step inside
-    yadebreak's PyRunners in each default run (YADE's engine timing); damage: events in the last
-    default run}}."""
+    yadebreak's PyRunners in each default run, "yade plain", "yade default": in YADE's other
+    engines (YADE's engine timing); damage: events in the last default run}}."""
     out = {}
     steps = steps_for(n)
     for kind in ("dense", "collisional"):
-        runs = {"plain": [], "default": [], "own": []}
+        runs = {"plain": [], "default": [], "own": [], "yade plain": [], "yade default": []}
         for _ in range(repeats):
             for mode in ("plain", "default"):     # the default last: its controller stays
                 prepare(kind, n, mode, breakable=True)
@@ -273,10 +274,13 @@ def _threads_child(n, repeats):
                 engine.run_steps(steps)
                 runs[mode].append(1e6 * (time.perf_counter() - t0) / steps)
                 O.timingEnabled = False
+                ours = [isinstance(e, _w.PyRunner) and e.label.startswith("yadebreak")
+                        for e in O.engines]
+                runs["yade " + mode].append(1e-3 * sum(
+                    e.execTime for e, own in zip(O.engines, ours) if not own) / steps)
                 if mode == "default":
                     runs["own"].append(1e-3 * sum(
-                        e.execTime for e in O.engines if isinstance(e, _w.PyRunner)
-                        and e.label.startswith("yadebreak")) / steps)
+                        e.execTime for e, own in zip(O.engines, ours) if own) / steps)
         out[kind] = dict(runs)
         out[kind]["damage"] = sum(e["kind"] == "damage" for e in engine.controller_of().events)
     print(json.dumps(out))
