@@ -108,9 +108,15 @@ def _queue(args):
     if not scenes.on_workers(scheduler, scenes.scene_counts(args.particles,
                                                            args.scene_particles)):
         return contextlib.nullcontext()
+    return started_queue(scheduler, args.retries)
+
+
+def started_queue(scheduler, retries):
+    """A SceneQueue on `scheduler`, started (verify's too); a scheduler that does not answer
+    stops the script in one line."""
     progress(f"scenes on {scheduler}")
     try:
-        return scenes.SceneQueue(scheduler, args.retries).start()
+        return scenes.SceneQueue(scheduler, retries).start()
     except SchedulerError as exc:
         raise ScriptError(str(exc)) from None
 

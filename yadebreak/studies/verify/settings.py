@@ -12,7 +12,7 @@ import numpy as np
 from yadebreak.criteria import load_material
 from yadebreak.analysis import reports
 from yadebreak.jobs import wall_time
-from yadebreak.jobs.lifecycle import ScriptError, progress, status
+from yadebreak.jobs.lifecycle import progress, status
 from yadebreak.options.engine_flags import OPTION, Override
 
 #: the paper's single-particle verification (its Section 3)
@@ -187,13 +187,8 @@ class Runner:
 
     def _queue_of(self):
         if self._queue is None:
-            from yadebreak.scenes.queue import SceneQueue
-            from yadebreak.process.scheduler import SchedulerError
-            progress(f"scenes on {self.scheduler}")
-            try:
-                self._queue = SceneQueue(self.scheduler, self.retries).start()
-            except SchedulerError as exc:
-                raise ScriptError(str(exc)) from None
+            from yadebreak.jobs.impacts import started_queue
+            self._queue = started_queue(self.scheduler, self.retries)
         return self._queue
 
     def _keep(self, run, energy, tally):
