@@ -173,20 +173,13 @@ class Tavares(Criterion):
         return table.columns["fracture_energy"][ids]
 
     def unload(self, table, i):
-        """Eqs. 5-6 with the event's largest Ek' (breakable bodies only)."""
-        c = table.columns
-        before = float(c["fracture_energy"][i])
-        ratio = float(c["event_max"][i]) / (float(c["mass"][i]) * before)
-        if c["kind"][i] != BREAKABLE:
-            return None
-        after = float(model.weakened_fracture_energy(before, ratio, self.params.gamma))
-        c["fracture_energy"][i] = after
-        c["damage"][i] = 1.0 - after / float(c["fracture_energy_initial"][i])
-        return {"fracture_energy": before, "fracture_energy_after": after, "ratio": ratio}
+        """Eqs. 5-6 with the event's largest Ek' (breakable bodies only): unload_all of one."""
+        return self.unload_all(table, [i])[0]
 
     def unload_all(self, table, ids):
-        """unload() of the bodies `ids` at once, with the same numbers: the columns gathered and
-        written with numpy, Eq. 6 solved body by body on floats as unload() solves it."""
+        """Eqs. 5-6 with each event's largest Ek' (breakable bodies only), for the bodies `ids`
+        at once: the columns gathered and written with numpy, Eq. 6 solved body by body on
+        floats (model.damage's one-ratio solver)."""
         c = table.columns
         rows = np.asarray(ids, np.int64)
         before = c["fracture_energy"][rows]

@@ -333,7 +333,7 @@ class TrackedBodies(set):
         set.add(self, i)
         mask = self._mask
         if mask is not None:
-            if i < len(mask):
+            if 0 <= i < len(mask):
                 mask[i] = True
             else:
                 self._mask = None

@@ -20,9 +20,8 @@ class Strongest(NamedTuple):
 
 
 def _places(ids, bodies):
-    """Where each of `bodies` (int64) is in the sorted `ids`, and whether it is there."""
-    if not len(ids):
-        return np.zeros(len(bodies), np.int64), np.zeros(len(bodies), bool)
+    """Where each of `bodies` (int64) is in the sorted, non-empty `ids`, and whether it is
+    there."""
     at = np.minimum(np.searchsorted(ids, bodies), len(ids) - 1)
     return at, ids[at] == bodies
 
@@ -112,5 +111,7 @@ class Loading:
         if self.ids is None:
             n = len(bodies)
             return np.fromiter(map(self._energy.get, bodies.tolist(), repeat(0.0, n)), float, n)
+        if not len(self.ids):
+            return np.zeros(len(bodies))
         at, found = _places(self.ids, bodies)
-        return np.where(found, self.sums[at], 0.0) if len(self.ids) else np.zeros(len(bodies))
+        return np.where(found, self.sums[at], 0.0)
