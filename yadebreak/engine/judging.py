@@ -292,13 +292,13 @@ class Judge:
         specific = (c["event_max"][rows] / c["mass"][rows]).tolist()
         partners = c["event_partner"][rows].tolist()
         criteria = self.criterion_of
-        materials = c["material"][rows]
+        materials = c["material"][rows].tolist()
         fields = [None] * len(ids)
-        for m in np.unique(materials).tolist():
-            at = (materials == m).nonzero()[0].tolist()
+        for m in set(materials):            # each criterion on its bodies (their own columns)
+            at = [k for k, of in enumerate(materials) if of == m]
             for k, f in zip(at, criteria[m].unload_all(table, [ids[k] for k in at])):
                 fields[k] = f
-        kinds = [criteria[m].event_kind for m in materials.tolist()]
+        kinds = [criteria[m].event_kind for m in materials]
         for i, kind, f, e, partner in zip(ids, kinds, fields, specific, partners):
             if f is not None:
                 self.record(kind, i, specific_energy=e, partner=int(partner), **f)
