@@ -25,7 +25,8 @@ of reach) under YADE's OpenMP on 1 and 2 threads, and on 2 threads with OMP_WAIT
 (threads that sleep, not spin, while the engine's Python runs), each in a process of its own,
 with the median of the ratios of runs made one after the other (steadier than the ratio of the
 medians on a shared machine) and yadebreak's own time per step inside its PyRunners (YADE's engine
-timing): what it adds, apart from what it does to YADE's own engines.
+timing): what it adds, apart from what it does to YADE's own engines. Its floor also makes the two
+passes in C++ that a read of a cloud makes (interaction counts, the most energetic body).
 """
 import argparse
 import gc
@@ -42,7 +43,7 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 import numpy as np  # noqa: E402
 
 from yadebreak import engine, scenes  # noqa: E402
-from yadebreak.adapter.yade_api import O, utils, wrapper as _w  # noqa: E402
+from yadebreak.adapter.yade_api import O, interaction_counts, utils, wrapper as _w  # noqa: E402
 from yadebreak.options.table import Config  # noqa: E402
 from yadebreak.engine.parts import protocol  # noqa: E402
 from yadebreak.engine.stepping import smallest_rayleigh_time  # noqa: E402
@@ -253,27 +254,55 @@ def threads(sizes, repeats):
                 f"+{np.median(r['default']) - np.median(r['plain']):.0f} us, of which "
                 f"{np.median(r['own']):.0f} us in yadebreak's PyRunners; YADE's engines "
                 f"{np.median(r['yade plain']):.0f} / {np.median(r['yade default']):.0f} us; "
-                f"{r['damage']} damage events)" for kind, r in got.items()))
+                f"{r['damage']} damage events; floor every {r['period']} steps "
+                f"{np.median(r['floor']):.1f}, {np.median(r['floor']) / np.median(r['plain']):.2f}x, "
+                f"paired {np.median(np.divide(r['floor'], r['plain'])):.2f}x, "
+                f"{np.median(r['floor own']):.0f} us in its PyRunner, YADE's engines "
+                f"{np.median(r['yade floor']):.0f} us)"
+                for kind, r in got.items()))
+        print("  floor: plain YADE with a read every k steps (k the default's mean read period) "
+              "that only makes a cloud's two passes in C++ (counts of interactions, the most "
+              "energetic body) and touches each contact's overlap and force: what any Python "
+              "read at that period costs")
 
 
 def _threads_child(n, repeats):
     """Part 7 in this process: each scene in plain YADE and with the default, in turn; one JSON
     line {kind: {plain, default: us per step of each run, in turn; own: us per step inside
     yadebreak's PyRunners in each default run, "yade plain", "yade default": in YADE's other
-    engines (YADE's engine timing); damage: events in the last default run}}."""
+    engines (YADE's engine timing); floor, "floor own", "yade floor": the floor's read (_floor
+    with its passes) at the default's mean read period `period` (steps), per step in all, in its
+    PyRunner and in YADE's engines; damage: events in the last default run}}."""
     out = {}
     steps = steps_for(n)
     for kind in ("dense", "collisional"):
-        runs = {"plain": [], "default": [], "own": [], "yade plain": [], "yade default": []}
+        runs = {"plain": [], "default": [], "own": [], "yade plain": [], "yade default": [],
+                "floor": [], "floor own": [], "yade floor": []}
+        period = None                             # the default's mean read period (steps)
         for _ in range(repeats):
-            for mode in ("plain", "default"):     # the default last: its controller stays
+            for mode in ("plain", "default", "floor"):  # the floor once the default ran
+                if mode == "floor":
+                    prepare(kind, n, "plain")
+                    gc.collect()
+                    O.timingEnabled = True
+                    runs[mode].append(_floor(steps, period, finding=False, passes=True))
+                    O.timingEnabled = False
+                    read = [isinstance(e, _w.PyRunner) for e in O.engines]
+                    for key, own in (("floor own", True), ("yade floor", False)):
+                        runs[key].append(1e-3 * sum(
+                            e.execTime for e, r in zip(O.engines, read) if r == own) / steps)
+                    continue
                 prepare(kind, n, mode, breakable=True)
                 gc.collect()
+                reads = _reads() if mode == "default" else 0
                 O.timingEnabled = True            # from here on: the timed steps only
                 t0 = time.perf_counter()
                 engine.run_steps(steps)
                 runs[mode].append(1e6 * (time.perf_counter() - t0) / steps)
                 O.timingEnabled = False
+                if mode == "default":
+                    period = max(1, round(steps / max(1, _reads() - reads)))
+                    damage = sum(e["kind"] == "damage" for e in engine.controller_of().events)
                 ours = [isinstance(e, _w.PyRunner) and e.label.startswith("yadebreak")
                         for e in O.engines]
                 runs["yade " + mode].append(1e-3 * sum(
@@ -282,7 +311,8 @@ def _threads_child(n, repeats):
                     runs["own"].append(1e-3 * sum(
                         e.execTime for e, own in zip(O.engines, ours) if own) / steps)
         out[kind] = dict(runs)
-        out[kind]["damage"] = sum(e["kind"] == "damage" for e in engine.controller_of().events)
+        out[kind]["period"] = period
+        out[kind]["damage"] = damage
     print(json.dumps(out))
 
 
@@ -350,13 +380,26 @@ def _touch_ore_contacts():
         phys.normalForce.norm()
 
 
-def _floor(steps, period, finding=True):
+def _passes():
+    """The floor's read of a cloud read "fast": _touch_ore_contacts, and the two passes in C++
+    that no Python read of it avoids: YADE's count of each body's interactions, over every
+    potential interaction (how a read finds new contacts without a pass in Python), and the
+    most energetic body, over every body (the schedule's closing speed)."""
+    interaction_counts()
+    utils.kineticEnergy(True)
+    _touch_ore_contacts()
+
+
+def _floor(steps, period, finding=True, passes=False):
     """us per step of the scene with only the floor's read every `period` steps; `finding`: the
     time of taking the contacts from YADE every 100 steps counted (the mill), else left out (a
-    bound below any reader, however it finds its contacts: part 1)."""
+    bound below any reader, however it finds its contacts: part 1); `passes`: the read also makes
+    the two passes in C++ that a "fast" read of a cloud makes (_passes)."""
     ore = {b.id for b in O.bodies if b is not None and b.material.label == "ore"}
-    O.engines = O.engines + [_w.PyRunner(iterPeriod=period, command="_touch_ore_contacts()")]
+    touch = "_passes()" if passes else "_touch_ore_contacts()"
+    O.engines = O.engines + [_w.PyRunner(iterPeriod=period, command=touch)]
     sys.modules["__main__"]._touch_ore_contacts = _touch_ore_contacts
+    sys.modules["__main__"]._passes = _passes
     left_out = 0.0
     t0 = time.perf_counter()
     for done in range(0, steps, 100):

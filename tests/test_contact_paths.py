@@ -33,7 +33,7 @@ def _rows(reader):
 
 @pytest.mark.parametrize("cs", [0.0, 0.5])
 def test_both_paths_read_a_breaking_bed_alike(scene, cs):
-    from yade import utils
+    from yadebreak.adapter.yade_api import interaction_counts
     from yadebreak import engine, scenes
     from yadebreak.engine.contacts import ContactReader
     brk, info = scenes.bed_impact_scene("copper_ore", 5.5e-3, 3, 1, 6.0, seed=4, read_period=1,
@@ -44,7 +44,7 @@ def test_both_paths_read_a_breaking_bed_alike(scene, cs):
     each.small, full.small, kept.small = 10 ** 9, -1, -1
     # `kept` is told the pairs the zeroing changed since its last read (ZeroedRows follows them),
     # `full` looks every row up in the zeroed and asleep pairs at every read
-    zeroed_then, asleep_then, changes, held = set(), set(), 0, 0
+    zeroed_then, asleep_then, changes, held, knos_kept = set(), set(), 0, 0, 0
     while not any(O.interactions.withBody(info["ball"])):
         engine.run_steps(50)
     scenes.hold_release(info)
@@ -62,7 +62,7 @@ def test_both_paths_read_a_breaking_bed_alike(scene, cs):
             continue
         state = brk.state
         args = (O.interactions, O.bodies, state.tracked, brk.zeroing.pairs, O.time, 3,
-                brk.zeroing.asleep, utils.numIntrsOfEachBody)
+                brk.zeroing.asleep, interaction_counts)
         zeroed_now, asleep_now = set(brk.zeroing.pairs), set(brk.zeroing.asleep)
         changed = (zeroed_now ^ zeroed_then) | (asleep_now ^ asleep_then)
         zeroed_then, asleep_then = zeroed_now, asleep_now
@@ -72,6 +72,10 @@ def test_both_paths_read_a_breaking_bed_alike(scene, cs):
         _same_loading(kept.read(*args, zeroing_changes=changed), by_full)
         assert _rows(kept) == _rows(full)
         changes += len(changed)
+        for r in (full, kept):   # a row's kno kept from its first numpy read is YADE's still
+            t = r.table
+            assert t.kno_of(np.arange(len(t))).tolist() == [p.kno for p in t.physs]
+            knos_kept += int(np.isfinite(t._kno).sum())
         # what a body's contacts hold, asked for many bodies at once or body by body
         asked = sorted(full.bodies_in_contact() & state.tracked)
         at_once = full.stored_shares(asked)
@@ -81,7 +85,39 @@ def test_both_paths_read_a_breaking_bed_alike(scene, cs):
         reads += 1
     assert brk.breakage_events, "the bed must break for the comparison to mean something"
     assert min(seen.values()) > 10, seen    # zeroed, sleeping and inherited pairs were read
-    assert len(full) > 0 and reads > 1000 and changes > 100 and held > 1000
+    assert len(full) > 0 and reads > 1000 and changes > 100 and held > 1000 and knos_kept > 1000
+
+
+def test_interaction_counts_are_yades_below_and_above_256(scene):
+    """adapter.yade_api.interaction_counts gives YADE's numIntrsOfEachBody as an array: through
+    bytes while every count is below 256 (spheres touching their neighbours), through fromiter
+    once a body has more (a wall under 300 spheres)."""
+    from yade import utils
+    from yade.wrapper import (Bo1_Sphere_Aabb, Bo1_Wall_Aabb, ForceResetter,
+                              Ig2_Sphere_Sphere_ScGeom, Ig2_Wall_Sphere_ScGeom,
+                              InsertionSortCollider, InteractionLoop,
+                              Ip2_FrictMat_FrictMat_FrictPhys, Law2_ScGeom_FrictPhys_CundallStrack,
+                              NewtonIntegrator)
+    from yadebreak.adapter.yade_api import interaction_counts
+    O = scene
+    O.engines = [ForceResetter(), InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Wall_Aabb()]),
+                 InteractionLoop([Ig2_Sphere_Sphere_ScGeom(), Ig2_Wall_Sphere_ScGeom()],
+                                 [Ip2_FrictMat_FrictMat_FrictPhys()],
+                                 [Law2_ScGeom_FrictPhys_CundallStrack()]),
+                 NewtonIntegrator()]
+    wall = O.bodies.append(utils.wall(0.0, axis=2))
+    O.bodies.append([utils.sphere((1.9 * i, 1.9 * j, 0.9), 1.0)
+                     for i in range(20) for j in range(15)])
+    O.dt = 1e-8
+    O.step()
+    counts = interaction_counts()
+    assert counts[wall] == 300 and counts.dtype == np.int64
+    assert counts.tolist() == utils.numIntrsOfEachBody()
+    O.bodies.erase(wall)
+    O.step()
+    counts = interaction_counts()
+    assert counts.dtype == np.uint8 and counts[wall] == 0 and counts.max() == 4
+    assert counts.tolist() == utils.numIntrsOfEachBody()
 
 
 def test_many_contacts_saved_and_loaded_read_on_as_the_run_that_went_on(scene, tmp_path):

@@ -14,11 +14,25 @@ if "yade" not in sys.modules:          # imported into plain Python (jobs, tests
     sys.stdout.write("".join(line for line in said.getvalue().splitlines(True)
                              if not line.startswith("Using python version")))
 
+import numpy as np  # noqa: E402
 import yade.wrapper as wrapper  # noqa: E402
 from yade import Matrix3, O, Quaternion, Vector3, geom, utils  # noqa: E402
 
 __all__ = ["Matrix3", "O", "Quaternion", "Vector3", "close_remote_access", "current_scene", "extend_match_makers",
-           "engine_time", "find_engine", "geom", "scene_folder", "table_row", "utils", "wrapper"]
+           "engine_time", "find_engine", "geom", "interaction_counts", "scene_folder", "table_row",
+           "utils", "wrapper"]
+
+
+def interaction_counts():
+    """Each body's count of real interactions, by id (YADE's numIntrsOfEachBody, one pass in C++
+    over every potential interaction), as a numpy array. Taken through bytes while every count
+    is below 256, as a cloud's are: on 8,000 bodies a tenth of np.fromiter's 150 us; a body with
+    more (a wall under a bed) falls back to fromiter."""
+    real = utils.numIntrsOfEachBody()
+    try:
+        return np.frombuffer(bytes(real), np.uint8)
+    except ValueError:
+        return np.fromiter(real, np.int64, len(real))
 
 
 def find_engine(label):

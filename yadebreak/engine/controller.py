@@ -15,7 +15,7 @@ import numpy as np
 
 from yadebreak.model import families
 from yadebreak.analysis import reports
-from yadebreak.adapter.yade_api import O, silence_polyhedra_pair_checks, utils
+from yadebreak.adapter.yade_api import O, interaction_counts, silence_polyhedra_pair_checks
 from yadebreak.engine.contacts import ContactReader, Strongest
 from yadebreak.engine.safeguards import LargeOverlaps
 from yadebreak.criteria import criterion_for
@@ -252,7 +252,7 @@ class Controller:
         interval = max(1, O.iter - self.last_iter)        # steps since the last read
         loading = self.reader.read(O.interactions, O.bodies, state.tracked, self.zeroing.pairs,
                                    O.time, interval, self.zeroing.asleep,
-                                   utils.numIntrsOfEachBody, self.zeroing.take_changes())
+                                   interaction_counts, self.zeroing.take_changes())
         self.wall_time["read"] += time.perf_counter() - t0
         follow = self.step_follows_loading
         broken, limits = self.judge.judge(loading, interval, O.iter,

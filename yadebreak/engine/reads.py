@@ -63,8 +63,14 @@ class Reach:
         onset = float(placement.hertz_onset_time(radius, material.density, material.young,
                                                  material.poisson, 1.0,
                                                  self.tolerance * fracture_energy))
-        self.current[bid] = onset
-        heapq.heappush(self.onset, (onset, bid))
+        self.set_onsets([bid], [onset])
+
+    def set_onsets(self, ids, onsets):
+        """The onset times (s, at 1 m/s) of the bodies `ids` are now `onsets` (lists)."""
+        current, heap = self.current, self.onset
+        for bid, onset in zip(ids, onsets):
+            current[bid] = onset
+            heapq.heappush(heap, (onset, bid))
 
     def get(self, tracked):
         """(onset time, loading time) at 1 m/s (s) over the bodies in `tracked`, None if none."""

@@ -44,16 +44,13 @@ class Tracking:
 
     def weakened(self, ids):
         """A damage lowered the fracture energy of the bodies `ids` (a list): "fast" reads
-        follow them."""
+        follow them (a collisional cloud weakens dozens a read: their times in numpy)."""
         if self.reach is None:
             return
         tracked = self.state.tracked
-        ids = [i for i in ids if i in tracked]
-        c = self.state.table.columns
-        bodies, update = O.bodies, self.reach.update
-        for i, radius, energy in zip(ids, c["radius"][ids].tolist(),
-                                     c["fracture_energy"][ids].tolist()):
-            update(i, radius, energy, bodies[i].material)
+        ids = np.array([i for i in ids if i in tracked], np.int64)
+        if len(ids):
+            self.reach.set_onsets(ids.tolist(), self._times(ids, loading=False)[0].tolist())
 
     def smallest_breakable(self):
         """(radius, id) of the smallest breakable body still tracked, None if none."""
@@ -69,18 +66,27 @@ class Tracking:
         return i in self.state.tracked and self.state.table.columns["kind"][i] == BREAKABLE
 
     def _rebuild_reach(self):
-        """The reach of every tracked body from the body table, material by material."""
-        c = self.state.table.columns
+        """The reach of every tracked body from the body table."""
         ids = np.array(sorted(self.state.tracked), np.int64)
-        onset, loading = np.empty(len(ids)), np.empty(len(ids))
+        onset, loading = self._times(ids)
+        self.reach.rebuild(ids.tolist(), onset.tolist(), loading.tolist())
+
+    def _times(self, ids, loading=True):
+        """The onset times at 1 m/s of the bodies `ids` (an array) at their present fracture
+        energies (Reach), and with `loading` their Hertz loading times (else None): numpy on
+        each material's bodies."""
+        c = self.state.table.columns
+        onset = np.empty(len(ids))
+        times = np.empty(len(ids)) if loading else None
         materials = c["material"][ids]
         for m in np.unique(materials).tolist():
-            rows = np.flatnonzero(materials == m)
+            rows = (materials == m).nonzero()[0]
             mat = O.bodies[int(ids[rows[0]])].material
             radius = c["radius"][ids[rows]]
             onset[rows] = placement.hertz_onset_time(
                 radius, mat.density, mat.young, mat.poisson, 1.0,
                 self.reach.tolerance * c["fracture_energy"][ids[rows]])
-            loading[rows] = placement.hertz_loading_time(radius, mat.density, mat.young,
-                                                         mat.poisson, 1.0)
-        self.reach.rebuild(ids.tolist(), onset.tolist(), loading.tolist())
+            if loading:
+                times[rows] = placement.hertz_loading_time(radius, mat.density, mat.young,
+                                                           mat.poisson, 1.0)
+        return onset, times

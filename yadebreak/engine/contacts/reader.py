@@ -23,8 +23,7 @@ from yadebreak.engine.contacts.arrays import ArrayRead
 from yadebreak.engine.contacts.hertz import HertzMindlin
 from yadebreak.engine.contacts.law import HertzMindlinWork, total_work
 from yadebreak.engine.contacts.table import (OFFSET_A, OFFSET_B, OFFSETS, OVERLAP, SHARE_A,
-                                             SHARE_B, SHARES, SHEAR_WORK, WORK, ContactTable,
-                                             take)
+                                             SHARE_B, SHARES, SHEAR_WORK, WORK, ContactTable)
 
 #: while the rows are at most this many a read goes contact by contact on Python scalars, beyond
 #: with numpy: measured, the scalar path costs about 1.7 us per contact, the numpy one about
@@ -60,8 +59,8 @@ class ContactReader:
         bodies read (a state.TrackedBodies, which also gives them as a mask). `zeroed` holds the
         pairs whose kno varies, `asleep` those of them that carry no force and are not updated
         now (they do no work), all keyed (smaller id, larger id); `interval` is the steps since
-        the last read; `counts()` gives the real interactions of each body id (YADE's
-        numIntrsOfEachBody, in C++): with it, a read of many contacts looks for new ones only
+        the last read; `counts()` gives the real interactions of each body id as an array
+        (adapter.yade_api.interaction_counts, one pass in C++): with it, a read of many contacts looks for new ones only
         around the bodies whose count changed; `zeroing_changes`, the pairs that entered or left
         `zeroed` or `asleep` since the last read (None: unknown), spares it looking every row up
         in them again."""
@@ -116,9 +115,9 @@ class ContactReader:
         shares = d[SHARES][side, row].tolist()
         totals = [0.0] * len(bodies)
         stored = self.law.stored
-        for place, share, phys, overlap_now in zip(places, shares, take(table.physs, row.tolist()),
-                                                   overlap[row].tolist()):
-            totals[place] += share * stored(phys.kno, overlap_now)
+        for place, share, kno, overlap_now in zip(places, shares, table.kno_of(row).tolist(),
+                                                  overlap[row].tolist()):
+            totals[place] += share * stored(kno, overlap_now)
         return totals
 
     @property

@@ -69,13 +69,15 @@ class ContactTable:
         self.set(np.empty(0, np.int64), np.empty(0, np.int64), np.empty((len(FIELDS), 0)), [], [])
 
     def set(self, a, b, data, geoms, physs, rows=None, incomplete=False, by_body=None,
-            index=None):
+            index=None, kno=None):
         """The rows anew: ids a, b; numbers as a block `data` or as `rows` (lists); YADE's
         objects (None after a restore: `incomplete` until a read finds them); a scalar read
-        also gives `by_body` (see rows_of) and `index` ((id1, id2) -> row)."""
+        also gives `by_body` (see rows_of) and `index` ((id1, id2) -> row); `kno`: the rows'
+        kno kept so far (see kno_of; None: none kept)."""
         self.a, self.b = a, b
         self._data, self._rows = data, rows
         self.geoms, self.physs = geoms, physs
+        self._kno = kno if kno is not None else np.full(len(a), np.nan)
         self.by_body = by_body
         self.index = index
         self._pairs = self._sides = self._per_body = None
@@ -122,12 +124,29 @@ class ContactTable:
         """Only the rows `rows` (indices, in order) stay."""
         kept = rows.tolist()
         self.set(self.a[rows], self.b[rows], self.data[:, rows], take(self.geoms, kept),
-                 take(self.physs, kept))
+                 take(self.physs, kept), kno=self._kno[rows])
 
     def append(self, a, b, data, geoms, physs):
         """New rows (ids, numbers FIELDS x new, YADE's objects) after the present ones."""
         self.set(np.concatenate((self.a, a)), np.concatenate((self.b, b)),
-                 np.concatenate((self.data, data), axis=1), self.geoms + geoms, self.physs + physs)
+                 np.concatenate((self.data, data), axis=1), self.geoms + geoms, self.physs + physs,
+                 kno=np.concatenate((self._kno, np.full(len(a), np.nan))))
+
+    def kno_of(self, rows, keep=False):
+        """kno (N/m^1.5) of YADE's physics of the rows `rows` (an index array). A row's kno is
+        taken from YADE once, when first asked with `keep`, then kept: the caller asks so only
+        of pairs the zeroing does not scale, whose kno YADE's Ip2 set when it made the contact
+        and leaves alone (zeroed pairs are a fresh fragment's from their first step, so a row
+        kept is never zeroed later). A cloud's read would otherwise fetch hundreds a read."""
+        kno = self._kno[rows]
+        missing = np.isnan(kno).nonzero()[0]
+        if len(missing):
+            at = rows[missing]
+            physs = self.physs
+            kno[missing] = np.fromiter([physs[k].kno for k in at.tolist()], float, len(at))
+            if keep:
+                self._kno[at] = kno[missing]
+        return kno
 
     def pairs(self):
         """The rows' RowPairs, kept until the rows change (most reads keep every row)."""
