@@ -42,7 +42,7 @@ class Reach:
     that begins between reads, closing at 1 m/s, brings one of them `tolerance` of its own present
     fracture energy (placement.hertz_onset_time; it scales as 1 / speed), and the least Hertz
     loading time at 1 m/s (~ speed^-1/5). Two heaps cleaned lazily: of bodies no longer tracked,
-    and of onset times a damage made stale (`update`); built anew from the body table every
+    and of onset times a damage made stale (`set_onsets`); built anew from the body table every
     SCAN_EVERY reads (`rebuild`), so that a fracture energy set by hand is followed too."""
 
     def __init__(self, tolerance):
@@ -56,17 +56,14 @@ class Reach:
         material (density, young, poisson)."""
         heapq.heappush(self.loading, (float(placement.hertz_loading_time(
             radius, material.density, material.young, material.poisson, 1.0)), bid))
-        self.update(bid, radius, fracture_energy, material)
-
-    def update(self, bid, radius, fracture_energy, material):
-        """The body's fracture energy changed (a damage): its onset time with it."""
         onset = float(placement.hertz_onset_time(radius, material.density, material.young,
                                                  material.poisson, 1.0,
                                                  self.tolerance * fracture_energy))
         self.set_onsets([bid], [onset])
 
     def set_onsets(self, ids, onsets):
-        """The onset times (s, at 1 m/s) of the bodies `ids` are now `onsets` (lists)."""
+        """The onset times (s, at 1 m/s) of the bodies `ids` are now `onsets` (lists): new
+        bodies, or a damage lowered their fracture energies (stale times are cleaned lazily)."""
         current, heap = self.current, self.onset
         for bid, onset in zip(ids, onsets):
             current[bid] = onset

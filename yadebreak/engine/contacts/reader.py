@@ -60,8 +60,8 @@ class ContactReader:
         pairs whose kno varies, `asleep` those of them that carry no force and are not updated
         now (they do no work), all keyed (smaller id, larger id); `interval` is the steps since
         the last read; `counts()` gives the real interactions of each body id as an array
-        (adapter.yade_api.interaction_counts, one pass in C++): with it, a read of many contacts looks for new ones only
-        around the bodies whose count changed; `zeroing_changes`, the pairs that entered or left
+        (adapter.yade_api.interaction_counts, one pass in C++): with it, a read of many
+        contacts looks for new ones only around the bodies whose count changed; `zeroing_changes`, the pairs that entered or left
         `zeroed` or `asleep` since the last read (None: unknown), spares it looking every row up
         in them again."""
         loading = self.contact_law.read(self, interactions, bodies, tracked, zeroed, now,
@@ -103,10 +103,7 @@ class ContactReader:
         pressed = overlap > 0.0
         if table.resting is not None:
             pressed &= ~table.resting   # asleep zeroed pairs: slack, kno 0, nothing held
-        ids_of = table.sides()
-        slot = np.full(max(int(ids_of.max(initial=0)), max(bodies)) + 1, -1, np.int64)
-        slot[bodies] = np.arange(len(bodies))     # body id -> its place in `bodies`
-        asked = slot[ids_of]                      # of each side, a over b (-1: not asked)
+        asked = table.places_of(bodies)
         counted = (asked >= 0) & pressed & (work - d[OFFSETS] >= self.emin)
         # the counted sides of the asked bodies (a few), each contact's a before its b (as
         # arrays.py takes them): in the order of each body's rows
@@ -141,11 +138,8 @@ class ContactReader:
                 self.restart(body)
             return
         d = table.data
-        ids_of = table.sides()
-        asked = np.zeros(max(int(ids_of.max(initial=0)), max(bodies)) + 1, bool)
-        asked[bodies] = True
-        at = asked[ids_of]                                 # a over b, as d[OFFSETS]
-        np.copyto(d[OFFSETS], total_work(d[WORK], d[SHEAR_WORK], self.cs), where=at)
+        np.copyto(d[OFFSETS], total_work(d[WORK], d[SHEAR_WORK], self.cs),
+                  where=table.places_of(bodies) >= 0)
 
     def erased(self, body):
         """`body` left the scene (a parent replaced): its rows go at the next read (YADE erased

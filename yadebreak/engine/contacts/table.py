@@ -160,6 +160,14 @@ class ContactTable:
             self._sides = np.stack((self.a, self.b))
         return self._sides
 
+    def places_of(self, bodies):
+        """Of each side of each row (2 x contacts, a over b, as sides()), the place of its body
+        in `bodies` (a non-empty list of ids), -1 for a body not in it."""
+        ids_of = self.sides()
+        slot = np.full(max(int(ids_of.max(initial=0)), max(bodies)) + 1, -1, np.int64)
+        slot[bodies] = np.arange(len(bodies))
+        return slot[ids_of]
+
     def sides_per_body(self, n):
         """How many rows each body id below n is a side of (n at least every id + 1), kept until
         the rows change."""
