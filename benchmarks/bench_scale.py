@@ -26,7 +26,10 @@ of reach) under YADE's OpenMP on 1 and 2 threads, and on 2 threads with OMP_WAIT
 with the median of the ratios of runs made one after the other (steadier than the ratio of the
 medians on a shared machine) and yadebreak's own time per step inside its PyRunners (YADE's engine
 timing): what it adds, apart from what it does to YADE's own engines. Its floor also makes the two
-passes in C++ that a read of a cloud makes (interaction counts, the most energetic body).
+passes in C++ that a read of a cloud makes (interaction counts, the most energetic body). Then, in
+one plain collisional scene, a Python runner as long as the default's read at its period, alive and
+dead in turn every 40 steps: how much longer YADE's own engines take beside it, with a runner that
+touches nothing of YADE's (spin) and one that streams memory (sweep).
 """
 import argparse
 import gc
@@ -260,10 +263,57 @@ def threads(sizes, repeats):
                 f"{np.median(r['floor own']):.0f} us in its PyRunner, YADE's engines "
                 f"{np.median(r['yade floor']):.0f} us)"
                 for kind, r in got.items()))
+            beside = got["collisional"]["beside"]
+            print(f"  {n:7d} bodies, {name:18s}: YADE's engines beside a Python runner as long "
+                  f"as the default's read, collisional, us more per step (quartiles of "
+                  f"{PAIRS} pairs of {SEGMENT}-step segments, runner alive and dead): " + "; ".join(
+                      f"{how} " + " / ".join(f"{v:+.0f}" for v in q) for how, q in beside.items()))
         print("  floor: plain YADE with a read every k steps (k the default's mean read period) "
               "that only makes a cloud's two passes in C++ (counts of interactions, the most "
               "energetic body) and touches each contact's overlap and force: what any Python "
               "read at that period costs")
+        print("  beside: spin, a loop on the clock that touches nothing of YADE's; sweep, passes "
+              "over a 32 MB array (memory traffic)")
+
+
+#: part 7's toggled runs: segments of this many steps, in this many pairs (a runner alive, dead)
+SEGMENT, PAIRS = 40, 40
+#: what part 7's toggled runner does for as long as yadebreak's read takes: a loop on the clock
+#: (Python that touches nothing of YADE's), or sweeps over a 32 MB array (memory traffic)
+BUSY = ("spin", "sweep")
+_SWEPT = np.zeros(4 << 20)
+
+
+def _busy(seconds, how):
+    """Work for `seconds` (s) in this process as BUSY says."""
+    end = time.perf_counter() + seconds
+    while time.perf_counter() < end:
+        if how == "sweep":
+            np.add(_SWEPT, 1.0, out=_SWEPT)
+
+
+def _beside(kind, n, period, seconds, how):
+    """How much longer YADE's own engines take per step (us) beside a Python runner every
+    `period` steps that works `seconds` (_busy `how`): one plain scene, the runner alive and dead
+    in turn for SEGMENT steps, PAIRS pairs, which cancels the drift of a shared machine. Returns
+    the quartiles of the paired differences."""
+    prepare(kind, n, "plain")
+    sys.modules["__main__"]._busy = _busy
+    runner = _w.PyRunner(iterPeriod=period, command=f"_busy({seconds!r}, {how!r})", dead=True)
+    O.engines = O.engines + [runner]
+    theirs = O.engines[:-1]
+    O.timingEnabled = True
+    diffs = []
+    for p in range(PAIRS):
+        per_step = {}
+        for alive in ((True, False) if p % 2 else (False, True)):
+            runner.dead = not alive
+            before = sum(e.execTime for e in theirs)
+            engine.run_steps(SEGMENT)
+            per_step[alive] = 1e-3 * (sum(e.execTime for e in theirs) - before) / SEGMENT
+        diffs.append(per_step[True] - per_step[False])
+    O.timingEnabled = False
+    return np.percentile(diffs, [25, 50, 75]).tolist()
 
 
 def _threads_child(n, repeats):
@@ -313,6 +363,9 @@ def _threads_child(n, repeats):
         out[kind] = dict(runs)
         out[kind]["period"] = period
         out[kind]["damage"] = damage
+        if kind == "collisional":                 # YADE's engines beside a read this long
+            read_s = 1e-6 * float(np.median(runs["own"])) * period
+            out[kind]["beside"] = {how: _beside(kind, n, period, read_s, how) for how in BUSY}
     print(json.dumps(out))
 
 

@@ -3,7 +3,8 @@ callgrind inside YADE's PyRunners only (where every line of yadebreak's per-step
 where they go: the Python interpreter, numpy, Boost.Python's conversions of YADE's objects, YADE's
 own functions called from Python, the C library.
 
-    /usr/bin/python3 benchmarks/own_instructions.py [--case ab_cloud|collisional] [--tree DIR]
+    /usr/bin/python3 benchmarks/own_instructions.py [--case ab_cloud|collisional|cloud_8000]
+                                                    [--tree DIR]
 
 Why instructions: on a shared machine the same run's time moves by tens of percent from one run
 to the next, more than a change of a few percent in yadebreak's Python; a count of instructions
@@ -17,6 +18,8 @@ Cases (issue 45's scenes):
                read every step; fragments pressed together for thousands of steps)
   collisional  benchmarks/bench_scale.py's collisional scene of 1,000 spheres, the default read
                mode, 400 steps after its warm-up
+  cloud_8000   its collisional scene of 8,000 spheres with the material's own fracture energies
+               (bench_scale.py's part 7: damage events, no breakage), 200 steps after its warm-up
 
 Needs valgrind (Debian: apt-get install valgrind); takes 1-5 minutes a case (callgrind runs the
 scene about 50 times slower). `--tree`: the yadebreak checkout to count (default: this one).
@@ -34,7 +37,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 #: the symbol of YADE's PyRunner::action, whose inside is counted
 RUNNER = "*PyRunner::action*"
-CASES = ("ab_cloud", "collisional")
+CASES = ("ab_cloud", "collisional", "cloud_8000")
 #: (label, pattern of a shared object's path), first match wins; the rest is "other"
 GROUPS = (("Python interpreter", r"/python3\.\d+$|libpython"),
           ("numpy", r"/numpy/"),
@@ -57,8 +60,12 @@ def run_case(case, tree):
         from yadebreak import engine     # the tree's, before bench_scale puts its own parent first
         sys.path.insert(0, str(Path(tree) / "benchmarks"))
         import bench_scale
-        bench_scale.prepare("collisional", 1000, "default")
-        engine.run_steps(400)
+        if case == "collisional":
+            bench_scale.prepare("collisional", 1000, "default")
+            engine.run_steps(400)
+        else:
+            bench_scale.prepare("collisional", 8000, "default", breakable=True)
+            engine.run_steps(200)
 
 
 def count(case, tree):

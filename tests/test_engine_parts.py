@@ -13,8 +13,8 @@ from yadebreak.options import table as config
 from yadebreak import criteria
 from yadebreak.engine.contacts import ContactReader, Loading, Strongest
 from yadebreak.engine.state import (BREAKABLE, DUMMY, FORMAT_VERSION, UNBREAKABLE, BodyTable,
-                                      EngineState, FinesLedger, SHARED_COLUMNS, assembled_columns,
-                                      check_format)
+                                      EngineState, EventLog, FinesLedger, SHARED_COLUMNS,
+                                      assembled_columns, check_format)
 
 
 # -- options ----------------------------------------------------------------------------------
@@ -281,8 +281,8 @@ def test_both_judge_paths_make_the_same_decisions(seed, at_peak):
         candidates = list(st.open_events.union(loading.energy))
         plan = getattr(judge, path)(candidates, loading, 3, 10, True)
         broken = judge.settle(candidates, plan, loading)
-        results.append((broken, records, sorted(st.open_events), plan.need, plan.order,
-                        sorted(plan.limits),
+        results.append((broken, records, sorted(st.open_events), np.asarray(plan.need).tolist(),
+                        plan.order, sorted(plan.limits),
                         json.dumps({k: v.tolist() for k, v in st.table.columns.items()})))
     each, every = results
     assert each[0] and each[1]          # the scene breaks some bodies and closes some events
@@ -342,6 +342,9 @@ def test_tracked_bodies_keep_their_mask_in_step_with_every_change():
     copy.add(11)                                          # a copy has a mask of its own
     assert 11 not in tracked.mask(12).nonzero()[0]
     assert not tracked.mask(12).flags.writeable
+    few = TrackedBodies([1, 30])              # built for ids below the largest tracked one (the
+    assert few.mask(5).tolist() == [False, True, False, False, False]      # judge asks so)
+    assert few.mask(31).nonzero()[0].tolist() == [1, 30]
 
 
 def test_docs_options_is_the_table_as_rendered_now():
@@ -431,3 +434,30 @@ def test_could_break_asks_for_the_fracture_energy_left_after_what_the_event_coun
     assert not brk.could_break([ids[2], 0], [1e9, 1e9]).any()  # 0: the plate
     ab = criteria.AbT10(load_material("ab_t10_ore"))
     assert ab.energy_to_break(brk.bodies, np.array(ids)).tolist() == [0.0] * 4
+
+
+# -- the event log: a read's events in one write ---------------------------------------------------
+def test_an_event_log_writes_a_reads_events_at_once_and_keeps_them_on_an_error(tmp_path):
+    path = tmp_path / "events.jsonl"
+    log = EventLog(path)
+    log.start()
+
+    def on_file():
+        return [json.loads(line) for line in path.read_text().splitlines()]
+    log.record({"kind": "damage", "id": 1})
+    assert on_file() == log.events                        # outside a read: at once
+    with log.held():
+        log.record({"kind": "damage", "id": 2})
+        log.record({"kind": "breakage", "id": 3})
+        assert len(log.events) == 3 and len(on_file()) == 1   # in memory now, on file at the end
+    assert on_file() == log.events
+    with pytest.raises(RuntimeError):
+        with log.held():
+            log.record({"kind": "damage", "id": 4})
+            raise RuntimeError("a replacement failed")
+    assert on_file() == log.events and len(log.events) == 4
+    full = EventLog("/dev/full")                          # every write fails: nothing half written
+    with pytest.raises(OSError):
+        with full.held():
+            full.record({"kind": "damage", "id": 5})
+    assert full.events == [{"kind": "damage", "id": 5}]

@@ -255,12 +255,13 @@ class Controller:
                                    interaction_counts, self.zeroing.take_changes())
         self.wall_time["read"] += time.perf_counter() - t0
         follow = self.step_follows_loading
-        broken, limits = self.judge.judge(loading, interval, O.iter,
-                                          follow or self.schedule.mode == "fast")
-        if self.large_overlaps is not None:
-            broken = broken + self.large_overlaps.due(self, loading, broken)
-        if broken:
-            self._break_all(broken)
+        with state.log.held():                    # the read's events: one write
+            broken, limits = self.judge.judge(loading, interval, O.iter,
+                                              follow or self.schedule.mode == "fast")
+            if self.large_overlaps is not None:
+                broken = broken + self.large_overlaps.due(self, loading, broken)
+            if broken:
+                self._break_all(broken)
         if follow:
             self.time_step.follow(limits, self.reader.bodies_in_contact)
         self.damping.release()

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import math
 import os
+from contextlib import contextmanager
 from pathlib import Path
 from typing import NamedTuple
 
@@ -204,7 +205,8 @@ class BodyRow:
 
 class EventLog:
     """Every breakage and damage event, in memory and, when a path is given, appended to a
-    JSON-lines file as it happens (flushed: a run that dies leaves its events)."""
+    JSON-lines file and flushed with the read that made it (held): a run that dies leaves its
+    events."""
 
     #: while coupling.engine.run_steps steps the scene, a list: a write that fails (a full disk)
     #: is put there for run_steps to raise after the step, outside YADE's loop (an error raised
@@ -215,6 +217,7 @@ class EventLog:
         self.path = None if path is None else Path(path)
         self.events = list(events)
         self._file = None
+        self._held = None                       # the lines of the events held (held())
 
     def start(self):
         """Begin a new log file (attach)."""
@@ -232,22 +235,46 @@ class EventLog:
             finally:                                # a full disk leaves no half file
                 tmp.unlink(missing_ok=True)
 
+    @contextmanager
+    def held(self):
+        """The events recorded in the block are in memory at once and go to the file in one
+        write and flush when it ends, even by an error: a read of a collisional cloud closes
+        dozens of stressing events, and a write and a flush each cost more than the event."""
+        if self.path is None or self._held is not None:
+            yield
+            return
+        self._held = []
+        try:
+            yield
+        finally:
+            lines, self._held = self._held, None
+            if lines:
+                self._write("".join(lines))
+
     def record(self, event):
         self.events.append(event)
         if self.path is not None:
-            whole = None
-            try:
-                if self._file is None:
-                    self.path.parent.mkdir(parents=True, exist_ok=True)
-                    self._file = open(self.path, "a", buffering=1)
-                whole = self._file.tell()
-                self._file.write(json.dumps(event) + "\n")
-                self._file.flush()
-            except OSError as exc:
-                self._cut(whole)
-                if EventLog.deferred is None:
-                    raise
-                EventLog.deferred.append(exc)
+            line = json.dumps(event) + "\n"
+            if self._held is not None:
+                self._held.append(line)
+            else:
+                self._write(line)
+
+    def _write(self, text):
+        """Append whole lines `text` to the file; a write that fails leaves the file as it was."""
+        whole = None
+        try:
+            if self._file is None:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                self._file = open(self.path, "a", buffering=1)
+            whole = self._file.tell()
+            self._file.write(text)
+            self._file.flush()
+        except OSError as exc:
+            self._cut(whole)
+            if EventLog.deferred is None:
+                raise
+            EventLog.deferred.append(exc)
 
     def _cut(self, size):
         """After a failed write: the file closed and cut back to its whole lines (`size` bytes;
@@ -348,12 +375,12 @@ class TrackedBodies(set):
         return TrackedBodies, (list(self),)
 
     def mask(self, n):
-        """Which of the ids 0 .. n-1 are tracked (a read-only view; n above every id)."""
+        """Which of the ids 0 .. n-1 are tracked (a read-only view)."""
         mask = self._mask
         if mask is None or len(mask) < n:
-            mask = np.zeros(n, bool)
-            if self:
-                mask[np.fromiter(self, np.int64, len(self))] = True
+            ids = np.fromiter(self, np.int64, len(self))
+            mask = np.zeros(max(n, int(ids.max()) + 1 if len(ids) else 0), bool)
+            mask[ids] = True
             self._mask = mask
         view = mask[:n]
         view.flags.writeable = False

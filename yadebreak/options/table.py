@@ -239,7 +239,8 @@ OPTIONS = (
          none="for as long as they exist", token="forever"),
     # output
     _row("event_log", "output", None, "path", "-",
-         "JSON-lines file that receives every event as it happens (missing folders are made)",
+         "JSON-lines file that receives every event, written with the read that made it "
+         "(missing folders are made)",
          none="no file"),
     _row("remote_access", "output", False, "boolean", "-",
          "keep the remote Python prompt and XMLRPC server that the `yade` launcher opens on "

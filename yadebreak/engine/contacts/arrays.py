@@ -152,21 +152,19 @@ class ArrayRead:
         changed = (mask & (have != counts())).nonzero()[0]
         fresh = None
         if len(changed):
-            kept, new = self._rescan(interactions, bodies, changed, now)
+            kept, new, new_geoms = self._rescan(interactions, bodies, changed, now)
             if kept is not None:
                 delta, restored = delta[kept], restored[kept]
                 if flags is not None:
                     flags.keep(kept)
             if new:
-                added = np.fromiter([inter.geom.penetrationDepth for inter in new], float,
-                                    len(new))
+                added = np.fromiter([g.penetrationDepth for g in new_geoms], float, len(new))
                 none = np.zeros(len(new), bool)
                 fresh = np.concatenate((np.zeros(len(delta), bool), ~none))
                 delta = np.concatenate((delta, added))
                 restored = np.concatenate((restored, none))
                 if flags is not None:
-                    flags.append([(min(i.id1, i.id2), max(i.id1, i.id2)) for i in new], zeroed,
-                                 asleep)
+                    flags.append([(a, b) if a < b else (b, a) for a, b in new], zeroed, asleep)
         if flags is not None:
             flags.pairs = table.pairs()
         return fresh, restored, delta
@@ -174,7 +172,7 @@ class ArrayRead:
     def _rescan(self, interactions, bodies, changed, now):
         """Rows of the bodies `changed` from YADE's own lists: rows not in them go, interactions
         not in the rows are appended as fresh rows. Returns the indices of the rows kept (None:
-        all) and the new interactions."""
+        all), the new rows' pairs (id1, id2) and their geometries."""
         table = self.table
         current = {}
         for bid in changed.tolist():
@@ -192,15 +190,16 @@ class ArrayRead:
             keep[stale] = False
             kept = keep.nonzero()[0]
             table.keep(kept)
-        new = [inter for key, inter in current.items() if key not in known]
-        if new:
-            a = np.array([i.id1 for i in new], np.int64)
-            b = np.array([i.id2 for i in new], np.int64)
-            stiffness = self.reader.stiffness
-            data = np.array([fresh_row(stiffness, bodies, ia, ib, now)
-                             for ia, ib in zip(a.tolist(), b.tolist())], float).T
-            table.append(a, b, data, [i.geom for i in new], [i.phys for i in new])
-        return kept, new
+        new = [(key, inter) for key, inter in current.items() if key not in known]
+        if not new:
+            return kept, [], []
+        pairs = [key for key, _ in new]
+        geoms = [inter.geom for _, inter in new]
+        stiffness = self.reader.stiffness
+        data = np.array([fresh_row(stiffness, bodies, ia, ib, now) for ia, ib in pairs], float).T
+        ab = np.array(pairs, np.int64).T
+        table.append(ab[0], ab[1], data, geoms, [inter.phys for _, inter in new])
+        return kept, pairs, geoms
 
     def _start_here(self, rows, delta, force, us, fs):
         """The fresh `rows` of inherited pairs count work from the present state on, not from
