@@ -279,7 +279,8 @@ def threads(sizes, repeats):
 #: part 7's toggled runs: segments of this many steps, in this many pairs (a runner alive, dead)
 SEGMENT, PAIRS = 40, 40
 #: what part 7's toggled runner does for as long as yadebreak's read takes: a loop on the clock
-#: (Python that touches nothing of YADE's), or sweeps over a 32 MB array (memory traffic)
+#: (Python that touches nothing of YADE's), or whole sweeps over a 32 MB array until the time is
+#: up (memory traffic; a sweep takes about 1.5 ms here, a read 3.5-4.5)
 BUSY = ("spin", "sweep")
 _SWEPT = np.zeros(4 << 20)
 
