@@ -46,7 +46,8 @@ sys.path.insert(0, str(Path(sys.argv[0]).resolve().parent.parent))
 import numpy as np  # noqa: E402
 
 from yadebreak import engine, scenes  # noqa: E402
-from yadebreak.adapter.yade_api import O, interaction_counts, utils, wrapper as _w  # noqa: E402
+from yadebreak.adapter.yade_api import (O, engine_time, interaction_counts, utils,  # noqa: E402
+                                        wrapper as _w)
 from yadebreak.options.table import Config  # noqa: E402
 from yadebreak.engine.parts import protocol  # noqa: E402
 from yadebreak.engine.stepping import smallest_rayleigh_time  # noqa: E402
@@ -258,7 +259,8 @@ def threads(sizes, repeats):
                 f"{np.median(r['own']):.0f} us in yadebreak's PyRunners; YADE's engines "
                 f"{np.median(r['yade plain']):.0f} / {np.median(r['yade default']):.0f} us; "
                 f"{r['damage']} damage events; floor every {r['period']} steps "
-                f"{np.median(r['floor']):.1f}, {np.median(r['floor']) / np.median(r['plain']):.2f}x, "
+                f"{np.median(r['floor']):.1f}, "
+                f"{np.median(r['floor']) / np.median(r['plain']):.2f}x, "
                 f"paired {np.median(np.divide(r['floor'], r['plain'])):.2f}x, "
                 f"{np.median(r['floor own']):.0f} us in its PyRunner, YADE's engines "
                 f"{np.median(r['yade floor']):.0f} us)"
@@ -302,18 +304,15 @@ def _beside(kind, n, period, seconds, how):
     sys.modules["__main__"]._busy = _busy
     runner = _w.PyRunner(iterPeriod=period, command=f"_busy({seconds!r}, {how!r})", dead=True)
     O.engines = O.engines + [runner]
-    theirs = O.engines[:-1]
-    O.timingEnabled = True
     diffs = []
     for p in range(PAIRS):
         per_step = {}
         for alive in ((True, False) if p % 2 else (False, True)):
             runner.dead = not alive
-            before = sum(e.execTime for e in theirs)
-            engine.run_steps(SEGMENT)
-            per_step[alive] = 1e-3 * (sum(e.execTime for e in theirs) - before) / SEGMENT
+            with engine_time() as yade:            # YADE's engines, the runner left out
+                engine.run_steps(SEGMENT)
+            per_step[alive] = 1e6 * yade.seconds / SEGMENT
         diffs.append(per_step[True] - per_step[False])
-    O.timingEnabled = False
     return np.percentile(diffs, [25, 50, 75]).tolist()
 
 

@@ -20,6 +20,8 @@ Cases (issue 45's scenes):
                mode, 400 steps after its warm-up
   cloud_8000   its collisional scene of 8,000 spheres with the material's own fracture energies
                (bench_scale.py's part 7: damage events, no breakage), 200 steps after its warm-up
+The scenes' warm-ups are counted too (their reads run in the same runners): compare trees, case
+by case, not a case's count with a time per step.
 
 Needs valgrind (Debian: apt-get install valgrind); takes 1-5 minutes a case (callgrind runs the
 scene about 50 times slower). `--tree`: the yadebreak checkout to count (default: this one).

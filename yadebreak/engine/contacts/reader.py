@@ -60,10 +60,10 @@ class ContactReader:
         pairs whose kno varies, `asleep` those of them that carry no force and are not updated
         now (they do no work), all keyed (smaller id, larger id); `interval` is the steps since
         the last read; `counts()` gives the real interactions of each body id as an array
-        (adapter.yade_api.interaction_counts, one pass in C++): with it, a read of many
-        contacts looks for new ones only around the bodies whose count changed; `zeroing_changes`, the pairs that entered or left
-        `zeroed` or `asleep` since the last read (None: unknown), spares it looking every row up
-        in them again."""
+        (adapter.yade_api.interaction_counts, one pass in C++): with it, a read of many contacts
+        looks for new ones only around the bodies whose count changed; `zeroing_changes`, the
+        pairs that entered or left `zeroed` or `asleep` since the last read (None: unknown),
+        spares it looking every row up in them again."""
         loading = self.contact_law.read(self, interactions, bodies, tracked, zeroed, now,
                                         interval, asleep, counts, zeroing_changes)
         self.inherited.clear()                 # read now or gone
