@@ -281,8 +281,8 @@ def test_both_judge_paths_make_the_same_decisions(seed, at_peak):
         candidates = list(st.open_events.union(loading.energy))
         plan = getattr(judge, path)(candidates, loading, 3, 10, True)
         broken = judge.settle(candidates, plan, loading)
-        results.append((broken, records, sorted(st.open_events), np.asarray(plan.need).tolist(),
-                        plan.order, sorted(plan.limits),
+        results.append((broken, records, sorted(st.open_events), plan.need, plan.order,
+                        sorted(plan.limits),
                         json.dumps({k: v.tolist() for k, v in st.table.columns.items()})))
     each, every = results
     assert each[0] and each[1]          # the scene breaks some bodies and closes some events

@@ -39,16 +39,14 @@ def steps_allowed(tolerance, threshold, level, rise, interval):
 
 class Plan:
     """A read's decisions: for each candidate its need (codes above), criterion order (None: one
-    criterion for all), Ek' (J), jump and threshold (J/kg; plan_all's need, Ek', jump and
-    threshold as arrays: settle takes its common needs at once and asks the rest of breaking
-    bodies only); and the steps the loaded bodies allow (a list; fast reads)."""
+    criterion for all), Ek' (J), jump and threshold (J/kg; plan_all's as arrays: they are asked
+    of breaking bodies only); and the steps the loaded bodies allow (a list; fast reads)."""
 
-    __slots__ = ("need", "order", "ek", "jump", "threshold", "limits", "ids")
+    __slots__ = ("need", "order", "ek", "jump", "threshold", "limits")
 
-    def __init__(self, need, order, ek, jump, threshold, limits, ids=None):
+    def __init__(self, need, order, ek, jump, threshold, limits):
         self.need, self.order, self.ek = need, order, ek
         self.jump, self.threshold, self.limits = jump, threshold, limits
-        self.ids = ids                  # plan_all's: the candidates as an array
 
 
 @dataclass(frozen=True)
@@ -161,8 +159,7 @@ class Judge:
         return Plan(need, order, eks, jumps, thresholds, limits)
 
     def plan_all(self, candidates, loading, interval, now_iter, fast):
-        """The same decisions with numpy over all the candidates (a list or an array of ids);
-        the needs as an array."""
+        """The same decisions with numpy over all the candidates (a list or an array of ids)."""
         c = self.state.table.columns
         ids = np.asarray(candidates, np.int64)
         n = len(ids)
@@ -217,8 +214,8 @@ class Judge:
         if known is not None:
             need[~known] = FORGET
         # Ek', jump and threshold stay arrays: settle asks them of breaking bodies only
-        return Plan(need, None if v.order is None else v.order.tolist(), ek, v.jump,
-                    v.threshold, limits, ids)
+        return Plan(need.tolist(), None if v.order is None else v.order.tolist(), ek, v.jump,
+                    v.threshold, limits)
 
     def settle(self, candidates, plan, loading):
         """Events open, close or break, body by body in the criteria's order (Tavares bodies,
@@ -230,8 +227,6 @@ class Judge:
             visit = sorted(visit, key=plan.order.__getitem__)      # stable
         unloaded = self._unloaded(candidates, plan, loading)
         closing = []                   # closed together once visited (each body's own state)
-        if isinstance(plan.need, np.ndarray):
-            visit = self._open_and_close(plan, visit, unloaded, closing)
         for k in visit:
             what = plan.need[k]
             if what == NOTHING:
@@ -262,23 +257,6 @@ class Judge:
         self.close_events(closing)
         return broken
 
-    def _open_and_close(self, plan, visit, unloaded, closing):
-        """settle's two common needs over plan_all's array of needs at once: the events that
-        open (or stay open) join the open events, and the unloaded bodies among those that may
-        close go to `closing`, in the order of `visit`. Returns the candidates left to visit
-        (breakages, pauses, bodies no longer tracked: a few), in that order; each body's needs
-        touch its own state only, so taking them by need keeps every outcome and its order."""
-        need, ids = plan.need, plan.ids
-        if isinstance(visit, range):
-            order, needs = np.arange(len(need)), need
-        else:
-            order = np.asarray(visit)
-            needs, ids = need[order], ids[order]
-        self.state.open_events.update(ids[needs == OPEN].tolist())
-        if unloaded:
-            closing.extend(i for i in ids[needs == CLOSE_IF_UNLOADED].tolist() if i in unloaded)
-        return order[(needs > NOTHING) & (needs < OPEN)].tolist()    # FORGET, PAUSE, BREAK
-
     def first_count(self, i, loading):
         """The specific energy (J/kg) body i's count rises by, at the least, when its strongest
         contact at this read is first counted: its share (Eq. 4) of emin, a contact's energy
@@ -295,12 +273,8 @@ class Judge:
         """The bodies whose event may close that unloaded: none of their contacts worked and
         their contacts hold at most emin (asked at once: closing one body's event restarts its
         own offsets only, so the order does not matter)."""
-        need, grew = plan.need, loading.grew
-        if isinstance(need, np.ndarray):          # plan_all's
-            asked = [i for i in plan.ids[need == CLOSE_IF_UNLOADED].tolist() if i not in grew]
-        else:
-            asked = [i for i, what in zip(candidates, need)
-                     if what == CLOSE_IF_UNLOADED and i not in grew]
+        asked = [i for i, what in zip(candidates, plan.need)
+                 if what == CLOSE_IF_UNLOADED and i not in loading.grew]
         if not asked:
             return ()
         emin = self.reader.emin
